@@ -1,0 +1,57 @@
+/*
+ * hunting_monitor - the vehicle configuration file (YAML, parsed with libyaml).
+ *
+ *   vehicle:                        # MODEL.md section 2 (SI units except stiffnesses in MN/m)
+ *     name: crh380_default          # optional
+ *     mass_kg: 1869
+ *     yaw_inertia_kg_m2: 910
+ *     contact_half_distance_m: 0.7465
+ *     spring_half_distance_m: 1.0
+ *     rolling_radius_m: 0.43
+ *     creep_long_n: 7.99e6
+ *     creep_lat_n: 7.99e6
+ *     spring_ratio: 1.351186        # l0/l1
+ *     kx_mn_m: 8.96
+ *     ky_mn_m: 8.96
+ *   conicity:                       # lambda(y) = constant + sum a exp(-((y - b)/c)^2)
+ *     constant: 0.1358
+ *     gaussians:
+ *       - {amplitude: 0.7, center_m: 0.01, width_m: 0.00145}
+ *   flange:                         # F_T(y) = alpha1 y^3 + alpha2 y^5
+ *     alpha1_n_m3: -1.6e11
+ *     alpha2_n_m5: 1.6e15
+ *
+ * Every key of the three sections is required (gaussians may be an empty list or absent); an unknown key
+ * inside them is an error; other top-level sections are left to other modules (monitor settings).
+ */
+#ifndef HUNTING_MONITOR_CONFIG_H
+#define HUNTING_MONITOR_CONFIG_H
+
+#include <stddef.h>
+
+#include "hunting_monitor/model.h"
+#include "hunting_monitor/status.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+#define HM_VEHICLE_NAME_MAX 64
+
+/*
+ * Parse a vehicle config from YAML text of len bytes. source names the text in messages (e.g. its path).
+ * On failure returns HM_EPARSE (malformed YAML, missing or unknown key, non-numeric value) or HM_EDOMAIN
+ * (a value outside its physical domain, see hm_vehicle_validate) and writes "source:line: key: reason"
+ * into err. name (may be NULL) receives vehicle.name or "". Outputs untouched on failure.
+ */
+hm_status hm_config_parse_vehicle(const char *text, size_t len, const char *source, hm_vehicle *veh, char *name,
+                                  char *err, size_t err_len);
+
+/* Read the file at path and parse it as above; HM_EIO if it cannot be read. */
+hm_status hm_config_load_vehicle(const char *path, hm_vehicle *veh, char *name, char *err, size_t err_len);
+
+#ifdef __cplusplus
+}
+#endif
+
+#endif

@@ -1,0 +1,166 @@
+#include "cli.h"
+
+#include <errno.h>
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "hunting_monitor/config.h"
+
+int cli_parse(const char *command, int argc, char **argv, const cli_option *opts, int allow_positional,
+              cli_args *out) {
+  memset(out, 0, sizeof *out);
+  for (int i = 0; i < argc; ++i) {
+    const char *arg = argv[i];
+    if (strncmp(arg, "--", 2) != 0) {
+      if (!allow_positional || out->positional) {
+        fprintf(stderr, "hunting %s: unexpected argument '%s' (see hunting %s --help)\n", command, arg, command);
+        return 1;
+      }
+      out->positional = arg;
+      continue;
+    }
+    const cli_option *o = opts;
+    while (o->name && strcmp(o->name, arg + 2) != 0) ++o;
+    if (!o->name) {
+      fprintf(stderr, "hunting %s: unknown option '%s' (see hunting %s --help)\n", command, arg, command);
+      return 1;
+    }
+    if (cli_has(out, o->name)) {
+      fprintf(stderr, "hunting %s: option --%s given twice\n", command, o->name);
+      return 1;
+    }
+    if (out->count == CLI_MAX_ARGS) {
+      fprintf(stderr, "hunting %s: too many options\n", command);
+      return 1;
+    }
+    const char *value = NULL;
+    if (o->arg) {
+      if (i + 1 >= argc) {
+        fprintf(stderr, "hunting %s: option --%s needs a value %s\n", command, o->name, o->arg);
+        return 1;
+      }
+      value = argv[++i];
+    }
+    out->names[out->count] = o->name;
+    out->values[out->count] = value;
+    out->count++;
+  }
+  return 0;
+}
+
+int cli_has(const cli_args *a, const char *name) {
+  for (int i = 0; i < a->count; ++i)
+    if (strcmp(a->names[i], name) == 0) return 1;
+  return 0;
+}
+
+const char *cli_value(const cli_args *a, const char *name) {
+  for (int i = 0; i < a->count; ++i)
+    if (strcmp(a->names[i], name) == 0) return a->values[i];
+  return NULL;
+}
+
+static int parse_double(const char *s, double *out) {
+  char *end = NULL;
+  errno = 0;
+  const double v = strtod(s, &end);
+  if (end == s || *end != '\0' || errno == ERANGE || !isfinite(v)) return 1;
+  *out = v;
+  return 0;
+}
+
+int cli_number(const cli_args *a, const char *name, double *out) {
+  const char *s = cli_value(a, name);
+  if (!s) return 0;
+  if (parse_double(s, out)) {
+    fprintf(stderr, "hunting: --%s: expected a finite number, got '%s'\n", name, s);
+    return 1;
+  }
+  return 0;
+}
+
+int cli_number_list(const cli_args *a, const char *name, double *out, int n) {
+  const char *s = cli_value(a, name);
+  if (!s) return 0;
+  char buf[256];
+  if (strlen(s) >= sizeof buf) {
+    fprintf(stderr, "hunting: --%s: value too long\n", name);
+    return 1;
+  }
+  strcpy(buf, s);
+  double tmp[16];
+  int count = 0;
+  for (char *tok = strtok(buf, ","); tok; tok = strtok(NULL, ",")) {
+    if (count == n || count == 16 || parse_double(tok, &tmp[count])) {
+      fprintf(stderr, "hunting: --%s: expected %d comma-separated finite numbers, got '%s'\n", name, n, s);
+      return 1;
+    }
+    ++count;
+  }
+  if (count != n) {
+    fprintf(stderr, "hunting: --%s: expected %d comma-separated finite numbers, got '%s'\n", name, n, s);
+    return 1;
+  }
+  memcpy(out, tmp, (size_t)n * sizeof(double));
+  return 0;
+}
+
+int cli_vehicle(const cli_args *a, hm_vehicle *veh, char *name) {
+  hm_vehicle v;
+  char err[512];
+  const char *path = cli_value(a, "config");
+  if (path) {
+    hm_status st = hm_config_load_vehicle(path, &v, name, err, sizeof err);
+    if (st != HM_OK) {
+      fprintf(stderr, "hunting: config error: %s\n", err);
+      return 1;
+    }
+  } else {
+    hm_vehicle_default(&v);
+    if (name) strcpy(name, "crh380_default (built-in)");
+  }
+  double kx = v.stiffness_long_n_m * 1e-6, ky = v.stiffness_lat_n_m * 1e-6, lambda0 = cli_conicity0(&v);
+  if (cli_number(a, "kx", &kx) || cli_number(a, "ky", &ky) || cli_number(a, "conicity", &lambda0)) return 1;
+  v.stiffness_long_n_m = kx * 1e6;
+  v.stiffness_lat_n_m = ky * 1e6;
+  if (hm_vehicle_set_conicity_at_zero(&v, lambda0) != HM_OK) {
+    fprintf(stderr, "hunting: --conicity %g: must be >= 0 and >= the Gaussian terms' value at y = 0\n", lambda0);
+    return 1;
+  }
+  if (hm_vehicle_validate(&v, err, sizeof err) != HM_OK) {
+    fprintf(stderr, "hunting: invalid vehicle: %s\n", err);
+    return 1;
+  }
+  *veh = v;
+  return 0;
+}
+
+double cli_conicity0(const hm_vehicle *veh) {
+  double l;
+  hm_conicity_eval(&veh->conicity, 0.0, &l, NULL);
+  return l;
+}
+
+void cli_print_help(FILE *f, const char *command, const char *usage, const char *summary, const cli_option *opts) {
+  fprintf(f, "usage: hunting %s %s\n\n%s\n\noptions:\n", command, usage, summary);
+  for (const cli_option *o = opts; o->name; ++o) {
+    char left[64];
+    snprintf(left, sizeof left, "--%s%s%s", o->name, o->arg ? " " : "", o->arg ? o->arg : "");
+    fprintf(f, "  %-22s %s\n", left, o->help);
+  }
+}
+
+void json_number(FILE *f, double x) { fprintf(f, "%.12g", x); }
+
+void json_eigenvalues(FILE *f, const double re[4], const double im[4]) {
+  fputc('[', f);
+  for (int i = 0; i < 4; ++i) {
+    fprintf(f, "%s[", i ? ", " : "");
+    json_number(f, re[i]);
+    fputs(", ", f);
+    json_number(f, im[i]);
+    fputc(']', f);
+  }
+  fputc(']', f);
+}

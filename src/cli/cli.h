@@ -1,0 +1,47 @@
+/* The `hunting` command-line tool: shared option handling and output helpers (no physics here). */
+#ifndef HM_CLI_H
+#define HM_CLI_H
+
+#include <stdio.h>
+
+#include "hunting_monitor/model.h"
+
+/* One option of a command: --name takes a value unless is_flag. */
+typedef struct {
+  const char *name;
+  const char *arg;  /* value placeholder in help, NULL for a flag */
+  const char *help;
+} cli_option;
+
+#define CLI_MAX_ARGS 32
+
+/* Parsed command line of one command: option names and values as given. */
+typedef struct {
+  int count;
+  const char *names[CLI_MAX_ARGS];
+  const char *values[CLI_MAX_ARGS]; /* NULL for flags */
+  const char *positional;           /* at most one positional argument */
+} cli_args;
+
+/* Parse argv against the options; prints the error to stderr and returns nonzero on a bad command line. */
+int cli_parse(const char *command, int argc, char **argv, const cli_option *opts, int allow_positional,
+              cli_args *out);
+int cli_has(const cli_args *a, const char *name);
+const char *cli_value(const cli_args *a, const char *name);
+/* Number option: returns 0 and sets *out (or leaves it if absent); nonzero with a message if malformed. */
+int cli_number(const cli_args *a, const char *name, double *out);
+/* Comma-separated list of exactly n numbers. */
+int cli_number_list(const cli_args *a, const char *name, double *out, int n);
+
+/* The vehicle: --config FILE or the built-in default, then --kx/--ky [MN/m] and --conicity (lambda(0)). */
+int cli_vehicle(const cli_args *a, hm_vehicle *veh, char *name);
+/* lambda(0) of the vehicle after overrides. */
+double cli_conicity0(const hm_vehicle *veh);
+
+void cli_print_help(FILE *f, const char *command, const char *usage, const char *summary, const cli_option *opts);
+
+/* JSON helpers: a number printed with 12 significant digits. */
+void json_number(FILE *f, double x);
+void json_eigenvalues(FILE *f, const double re[4], const double im[4]);
+
+#endif

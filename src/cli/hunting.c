@@ -1,0 +1,408 @@
+/* hunting: command-line front end of the hunting_monitor C core (argument parsing and output only). */
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "cli.h"
+#include "hunting_monitor/config.h"
+#include "hunting_monitor/integrate.h"
+#include "hunting_monitor/linear.h"
+#include "hunting_monitor/lyapunov.h"
+#include "hunting_monitor/model.h"
+
+#define VEHICLE_OPTIONS                                                                                      \
+  {"config", "FILE", "vehicle config YAML (default: built-in CRH380 defaults = config/crh380_default.yaml)"}, \
+      {"kx", "MN/m", "primary longitudinal stiffness Kx (overrides the config)"},                            \
+      {"ky", "MN/m", "primary lateral stiffness Ky (overrides the config)"},                                 \
+      {"conicity", "L", "equivalent conicity at y = 0 (shifts the constant term of lambda(y))"},            \
+      {"help", NULL, "show this help"}
+
+static int fail_status(const char *what, hm_status st) {
+  fprintf(stderr, "hunting: %s: %s\n", what, hm_status_str(st));
+  return 1;
+}
+
+/* Speed option --v in km/h, required, > 0. */
+static int speed_option(const cli_args *a, double *v_kmh) {
+  if (!cli_has(a, "v")) {
+    fprintf(stderr, "hunting: --v KM/H (running speed) is required\n");
+    return 1;
+  }
+  if (cli_number(a, "v", v_kmh)) return 1;
+  if (!(*v_kmh > 0.0)) {
+    fprintf(stderr, "hunting: --v must be > 0 km/h, got %g\n", *v_kmh);
+    return 1;
+  }
+  return 0;
+}
+
+/* ---- critical ---- */
+
+static const cli_option critical_opts[] = {VEHICLE_OPTIONS, {NULL, NULL, NULL}};
+
+static int cmd_critical(const cli_args *a) {
+  hm_vehicle veh;
+  if (cli_vehicle(a, &veh, NULL)) return 1;
+  const double lambda = cli_conicity0(&veh);
+  double v_mps, omega, re[4], im[4];
+  hm_status st = hm_linear_critical_speed(&veh, lambda, &v_mps);
+  if (st == HM_ENOCRIT) {
+    double abscissa = 0.0; /* with no crossing, the stability at any one speed holds at every speed */
+    hm_linear_spectral_abscissa(&veh, lambda, 1.0, &abscissa);
+    fprintf(stderr, "hunting: no critical speed: the linear model at conicity %g is %s at every speed\n", lambda,
+            abscissa < 0.0 ? "stable" : "unstable");
+    return 1;
+  }
+  if (st != HM_OK) return fail_status("critical speed", st);
+  if ((st = hm_linear_hopf_omega(&veh, &omega)) != HM_OK) return fail_status("Hopf frequency", st);
+  if ((st = hm_linear_eigenvalues(&veh, lambda, v_mps, re, im)) != HM_OK) return fail_status("eigenvalues", st);
+  printf("{\"v_crit_kmh\": ");
+  json_number(stdout, hm_kmh_from_mps(v_mps));
+  printf(", \"v_crit_mps\": ");
+  json_number(stdout, v_mps);
+  printf(", \"frequency_hz\": ");
+  json_number(stdout, omega / (2.0 * HM_PI));
+  printf(", \"omega_rad_s\": ");
+  json_number(stdout, omega);
+  printf(", \"conicity\": ");
+  json_number(stdout, lambda);
+  printf(", \"kx_mn_m\": ");
+  json_number(stdout, veh.stiffness_long_n_m * 1e-6);
+  printf(", \"ky_mn_m\": ");
+  json_number(stdout, veh.stiffness_lat_n_m * 1e-6);
+  printf(", \"eigenvalues\": ");
+  json_eigenvalues(stdout, re, im);
+  printf("}\n");
+  return 0;
+}
+
+/* ---- critical-conicity ---- */
+
+static const cli_option critical_conicity_opts[] = {
+    {"v", "KM/H", "running speed (required)"}, VEHICLE_OPTIONS, {NULL, NULL, NULL}};
+
+static int cmd_critical_conicity(const cli_args *a) {
+  hm_vehicle veh;
+  double v_kmh, lambda_c;
+  if (cli_vehicle(a, &veh, NULL) || speed_option(a, &v_kmh)) return 1;
+  hm_status st = hm_linear_critical_conicity(&veh, hm_mps_from_kmh(v_kmh), &lambda_c);
+  if (st == HM_ENOCRIT) {
+    fprintf(stderr, "hunting: no critical conicity: the linear model is unstable at %g km/h for every conicity\n",
+            v_kmh);
+    return 1;
+  }
+  if (st != HM_OK) return fail_status("critical conicity", st);
+  printf("{\"v_kmh\": ");
+  json_number(stdout, v_kmh);
+  printf(", \"conicity_crit\": ");
+  json_number(stdout, lambda_c);
+  printf("}\n");
+  return 0;
+}
+
+/* ---- eig ---- */
+
+static const cli_option eig_opts[] = {{"v", "KM/H", "running speed (required)"}, VEHICLE_OPTIONS, {NULL, NULL, NULL}};
+
+static int cmd_eig(const cli_args *a) {
+  hm_vehicle veh;
+  double v_kmh, re[4], im[4];
+  if (cli_vehicle(a, &veh, NULL) || speed_option(a, &v_kmh)) return 1;
+  const double lambda = cli_conicity0(&veh);
+  hm_status st = hm_linear_eigenvalues(&veh, lambda, hm_mps_from_kmh(v_kmh), re, im);
+  if (st != HM_OK) return fail_status("eigenvalues", st);
+  printf("{\"v_kmh\": ");
+  json_number(stdout, v_kmh);
+  printf(", \"conicity\": ");
+  json_number(stdout, lambda);
+  printf(", \"eigenvalues\": ");
+  json_eigenvalues(stdout, re, im);
+  printf(", \"stable\": %s}\n", re[0] < 0.0 ? "true" : "false");
+  return 0;
+}
+
+/* ---- simulate ---- */
+
+static const cli_option simulate_opts[] = {
+    {"v", "KM/H", "running speed (required)"},
+    {"x0", "Y,DY,PSI,DPSI", "initial state [m, m/s, rad, rad/s] (default 0.001,0,0,0)"},
+    {"t", "SECONDS", "simulated time (default 10)"},
+    {"dt-out", "SECONDS", "output interval, dense output of the integrator (default 0.001)"},
+    {"out", "FILE", "write the CSV there instead of stdout"},
+    {"linear", NULL, "linear model: constant conicity lambda(0), no flange force"},
+    {"rtol", "R", "relative tolerance of Dormand-Prince 5(4) (default 1e-9)"},
+    {"atol", "A", "absolute tolerance (default 1e-12)"},
+    VEHICLE_OPTIONS,
+    {NULL, NULL, NULL}};
+
+typedef struct {
+  FILE *out;
+  const hm_model *model;
+  double dt_out;
+  size_t next_index; /* next output time = next_index * dt_out */
+  double t1;
+  hm_status error;
+} sim_writer;
+
+static void write_row(sim_writer *w, double t, const double *x) {
+  double dx[4];
+  hm_status st = hm_model_rhs(t, x, dx, (void *)w->model);
+  if (st != HM_OK) w->error = st;
+  fprintf(w->out, "%.9g,%.12g,%.12g,%.12g,%.12g,%.12g\n", t, x[0], x[1], x[2], x[3], dx[1]);
+}
+
+static int sim_observer(hm_dopri integ, double t_old, double t_new, const double *x_new, void *ctx) {
+  sim_writer *w = (sim_writer *)ctx;
+  (void)t_old;
+  (void)x_new;
+  for (;;) {
+    const double t = (double)w->next_index * w->dt_out;
+    if (t > t_new + 1e-12 * w->dt_out || t > w->t1 + 1e-9 * w->dt_out) break;
+    double x[4];
+    if (hm_dopri_dense(integ, fmin(t, t_new), x) != HM_OK) {
+      w->error = HM_EINVAL;
+      return 1;
+    }
+    write_row(w, t, x);
+    w->next_index++;
+  }
+  return 0;
+}
+
+static int cmd_simulate(const cli_args *a) {
+  hm_vehicle veh, lin;
+  double v_kmh, x[4] = {0.001, 0.0, 0.0, 0.0}, t_end = 10.0, dt_out = 0.001, rtol = 1e-9, atol = 1e-12;
+  if (cli_vehicle(a, &veh, NULL) || speed_option(a, &v_kmh) || cli_number_list(a, "x0", x, 4) ||
+      cli_number(a, "t", &t_end) || cli_number(a, "dt-out", &dt_out) || cli_number(a, "rtol", &rtol) ||
+      cli_number(a, "atol", &atol))
+    return 1;
+  if (!(t_end > 0.0) || !(dt_out > 0.0) || t_end / dt_out > 1e8 || !(rtol > 0.0) || !(atol >= 0.0)) {
+    fprintf(stderr, "hunting simulate: need --t > 0, --dt-out > 0 (at most 1e8 rows), --rtol > 0, --atol >= 0\n");
+    return 1;
+  }
+  if (cli_has(a, "linear")) {
+    hm_vehicle_linearized(&veh, &lin);
+    veh = lin;
+  }
+  hm_model model;
+  hm_status st = hm_model_init(&model, &veh, hm_mps_from_kmh(v_kmh));
+  if (st != HM_OK) return fail_status("model", st);
+  const char *path = cli_value(a, "out");
+  FILE *out = path ? fopen(path, "w") : stdout;
+  if (!out) {
+    perror(path);
+    return 1;
+  }
+  fprintf(out, "t_s,y_m,dy_mps,psi_rad,dpsi_radps,accel_lat_mps2\n");
+  sim_writer w = {out, &model, dt_out, 1, t_end, HM_OK};
+  write_row(&w, 0.0, x);
+  hm_dopri integ = hm_dopri_create(4);
+  if (!integ) return fail_status("integrator", HM_ENOMEM);
+  const hm_ode_system sys = {4, hm_model_rhs, hm_model_jacobian, &model};
+  const hm_dopri_options opt = {rtol, atol, 0.0, 0.0, 0};
+  st = hm_dopri_integrate(integ, &sys, &opt, 0.0, t_end, x, NULL, sim_observer, &w, NULL);
+  hm_dopri_destroy(integ);
+  if (st == HM_OK) st = w.error;
+  if (path) fclose(out);
+  if (st != HM_OK) return fail_status("simulation (the trajectory diverged or the step size collapsed)", st);
+  return 0;
+}
+
+/* ---- lyapunov ---- */
+
+static const cli_option lyapunov_opts[] = {
+    {"v", "KM/H", "running speed (required)"},
+    {"x0", "Y,DY,PSI,DPSI", "initial state (default: the origin, whose exponents are its eigenvalues' real parts)"},
+    {"t", "SECONDS", "averaging time (default 100)"},
+    {"transient", "SECONDS", "time integrated before averaging (default 0)"},
+    {"method", "NAME", "midpoint (implicit midpoint rule, default) or dopri (Dormand-Prince 5(4))"},
+    {"h", "SECONDS", "midpoint step (default 1e-4)"},
+    {"renorm", "SECONDS", "QR re-orthonormalisation interval (default 0.01)"},
+    {"rtol", "R", "dopri relative tolerance (default 1e-9)"},
+    {"atol", "A", "dopri absolute tolerance (default 1e-12)"},
+    {"linear", NULL, "linear model: constant conicity lambda(0), no flange force"},
+    VEHICLE_OPTIONS,
+    {NULL, NULL, NULL}};
+
+static int cmd_lyapunov(const cli_args *a) {
+  hm_vehicle veh, lin;
+  hm_lyap_options opt;
+  hm_lyap_options_default(&opt);
+  double v_kmh, x[4] = {0.0, 0.0, 0.0, 0.0};
+  if (cli_vehicle(a, &veh, NULL) || speed_option(a, &v_kmh) || cli_number_list(a, "x0", x, 4) ||
+      cli_number(a, "t", &opt.duration_s) || cli_number(a, "transient", &opt.transient_s) ||
+      cli_number(a, "h", &opt.step_s) || cli_number(a, "renorm", &opt.renorm_interval_s) ||
+      cli_number(a, "rtol", &opt.rtol) || cli_number(a, "atol", &opt.atol))
+    return 1;
+  const char *method = cli_value(a, "method");
+  if (method && strcmp(method, "dopri") == 0)
+    opt.method = HM_LYAP_DOPRI;
+  else if (method && strcmp(method, "midpoint") != 0) {
+    fprintf(stderr, "hunting lyapunov: --method must be midpoint or dopri, got '%s'\n", method);
+    return 1;
+  }
+  const int linear = cli_has(a, "linear");
+  if (linear) {
+    hm_vehicle_linearized(&veh, &lin);
+    veh = lin;
+  }
+  hm_model model;
+  hm_status st = hm_model_init(&model, &veh, hm_mps_from_kmh(v_kmh));
+  if (st != HM_OK) return fail_status("model", st);
+  const hm_ode_system sys = {4, hm_model_rhs, hm_model_jacobian, &model};
+  double exps[4], x_end[4], re[4], im[4];
+  st = hm_lyapunov_spectrum(&sys, 0.0, x, 4, &opt, exps, x_end);
+  if (st == HM_EINVAL) {
+    fprintf(stderr, "hunting lyapunov: invalid options (need --t > 0, --transient >= 0, 0 < --h <= --renorm)\n");
+    return 1;
+  }
+  if (st != HM_OK) return fail_status("Lyapunov spectrum", st);
+  printf("{\"v_kmh\": ");
+  json_number(stdout, v_kmh);
+  printf(", \"model\": \"%s\", \"method\": \"%s\", \"exponents\": [", linear ? "linear" : "nonlinear",
+         opt.method == HM_LYAP_DOPRI ? "dopri" : "midpoint");
+  for (int i = 0; i < 4; ++i) {
+    if (i) printf(", ");
+    json_number(stdout, exps[i]);
+  }
+  printf("], \"x_end\": [");
+  for (int i = 0; i < 4; ++i) {
+    if (i) printf(", ");
+    json_number(stdout, x_end[i]);
+  }
+  printf("]");
+  if (linear && hm_linear_eigenvalues(&veh, cli_conicity0(&veh), model.speed_mps, re, im) == HM_OK) {
+    printf(", \"eigenvalue_real_parts\": [");
+    for (int i = 0; i < 4; ++i) {
+      if (i) printf(", ");
+      json_number(stdout, re[i]);
+    }
+    printf("]");
+  }
+  printf("}\n");
+  return 0;
+}
+
+/* ---- sweep ---- */
+
+static const cli_option sweep_opts[] = {
+    {"from", "L", "first conicity (default 0.05)"},
+    {"to", "L", "last conicity (default 0.40)"},
+    {"n", "COUNT", "number of conicities (default 15)"},
+    {"table", NULL, "print a readable table instead of JSON"},
+    VEHICLE_OPTIONS,
+    {NULL, NULL, NULL}};
+
+static int cmd_sweep(const cli_args *a) {
+  hm_vehicle veh;
+  char name[HM_VEHICLE_NAME_MAX + 32];
+  double from = 0.05, to = 0.40, n_d = 15, omega;
+  if (cli_vehicle(a, &veh, name) || cli_number(a, "from", &from) || cli_number(a, "to", &to) ||
+      cli_number(a, "n", &n_d))
+    return 1;
+  if (!(from > 0.0) || !(to >= from) || !(n_d >= 1.0 && n_d <= 10000.0) || n_d != floor(n_d)) {
+    fprintf(stderr, "hunting sweep: need 0 < --from <= --to and an integer --n in 1..10000\n");
+    return 1;
+  }
+  hm_status st = hm_linear_hopf_omega(&veh, &omega);
+  if (st != HM_OK) return fail_status("Hopf frequency", st);
+  const int n = (int)n_d, table = cli_has(a, "table");
+  if (table) {
+    printf("Linear critical (Hopf) speed of the wheelset vs equivalent conicity\n");
+    printf("vehicle %s: Kx = %.2f MN/m, Ky = %.2f MN/m; hunting frequency at criticality %.3f Hz\n\n", name,
+           veh.stiffness_long_n_m * 1e-6, veh.stiffness_lat_n_m * 1e-6, omega / (2.0 * HM_PI));
+    printf("  conicity   critical speed [km/h]\n");
+  } else {
+    printf("{\"kx_mn_m\": %.12g, \"ky_mn_m\": %.12g, \"frequency_hz\": %.12g, \"rows\": [",
+           veh.stiffness_long_n_m * 1e-6, veh.stiffness_lat_n_m * 1e-6, omega / (2.0 * HM_PI));
+  }
+  for (int i = 0; i < n; ++i) {
+    const double lambda = n == 1 ? from : from + (to - from) * i / (n - 1);
+    double v_mps;
+    st = hm_linear_critical_speed(&veh, lambda, &v_mps);
+    if (st != HM_OK && st != HM_ENOCRIT) return fail_status("critical speed", st);
+    if (table) {
+      if (st == HM_OK)
+        printf("  %8.4f   %10.2f\n", lambda, hm_kmh_from_mps(v_mps));
+      else
+        printf("  %8.4f   %10s\n", lambda, "none");
+    } else {
+      printf("%s{\"conicity\": %.12g, \"v_crit_kmh\": ", i ? ", " : "", lambda);
+      if (st == HM_OK)
+        json_number(stdout, hm_kmh_from_mps(v_mps));
+      else
+        printf("null");
+      printf("}");
+    }
+  }
+  if (!table) printf("]}\n");
+  return 0;
+}
+
+/* ---- dispatch ---- */
+
+typedef struct {
+  const char *name;
+  const char *brief; /* one line for the command list */
+  const char *usage;
+  const char *summary;
+  const cli_option *opts;
+  int (*run)(const cli_args *a);
+} command;
+
+static const command commands[] = {
+    {"critical", "linear critical (Hopf) speed, hunting frequency, eigenvalues there", "[options]",
+     "Linear critical (Hopf) speed from the closed-form Hurwitz condition, the hunting frequency there, and the\n"
+     "eigenvalues at that speed (LAPACK dgeev). JSON: v_crit_kmh, frequency_hz, eigenvalues [[re, im], ...].",
+     critical_opts, cmd_critical},
+    {"critical-conicity", "critical equivalent conicity at a speed", "--v KM/H [options]",
+     "Largest equivalent conicity for which the linear model is stable at the given speed (closed form).",
+     critical_conicity_opts, cmd_critical_conicity},
+    {"eig", "eigenvalues of the linearised model and stability", "--v KM/H [options]",
+     "Eigenvalues [1/s] of the linearised model at the origin and whether it is stable.", eig_opts, cmd_eig},
+    {"simulate", "time integration of the nonlinear model to CSV", "--v KM/H [--x0 Y,DY,PSI,DPSI] [--t SECONDS] [options]",
+     "Integrate the nonlinear model (Dormand-Prince 5(4), error control, dense output) and write CSV:\n"
+     "t_s,y_m,dy_mps,psi_rad,dpsi_radps,accel_lat_mps2 (the lateral acceleration is dy'/dt of the model).",
+     simulate_opts, cmd_simulate},
+    {"lyapunov", "Lyapunov exponent spectrum of a trajectory", "--v KM/H [--linear] [options]",
+     "Lyapunov exponent spectrum [1/s] of a trajectory (Benettin with QR re-orthonormalisation), by the\n"
+     "implicit midpoint rule (the study's method) or Dormand-Prince on the variational equations.",
+     lyapunov_opts, cmd_lyapunov},
+    {"sweep", "linear critical speed over a conicity range", "[--from L --to L --n COUNT] [--table]",
+     "Linear critical speed over a range of equivalent conicities (JSON, or a table with --table).", sweep_opts,
+     cmd_sweep},
+};
+
+static void print_main_help(FILE *f) {
+  fprintf(f,
+          "usage: hunting COMMAND [options]\n\n"
+          "Stability analysis of a railway wheelset against hunting (MODEL.md). Speeds are in km/h, stiffnesses\n"
+          "in MN/m, everything else SI. Results are JSON on stdout (CSV for simulate); errors go to stderr\n"
+          "with a non-zero exit status.\n\ncommands:\n");
+  for (size_t i = 0; i < sizeof commands / sizeof commands[0]; ++i)
+    fprintf(f, "  %-18s %s\n", commands[i].name, commands[i].brief);
+  fprintf(f, "\n'hunting COMMAND --help' describes a command's options.\n"
+             "example: hunting critical --kx 8.96 --ky 8.96 --conicity 0.1271\n");
+}
+
+int main(int argc, char **argv) {
+  if (argc < 2 || strcmp(argv[1], "--help") == 0 || strcmp(argv[1], "-h") == 0 || strcmp(argv[1], "help") == 0) {
+    print_main_help(argc < 2 ? stderr : stdout);
+    return argc < 2 ? 2 : 0;
+  }
+  for (size_t i = 0; i < sizeof commands / sizeof commands[0]; ++i) {
+    const command *c = &commands[i];
+    if (strcmp(argv[1], c->name) != 0) continue;
+    cli_args args;
+    if (cli_parse(c->name, argc - 2, argv + 2, c->opts, 0, &args)) return 2;
+    if (cli_has(&args, "help")) {
+      cli_print_help(stdout, c->name, c->usage, c->summary, c->opts);
+      return 0;
+    }
+    return c->run(&args);
+  }
+  fprintf(stderr, "hunting: unknown command '%s'\n\n", argv[1]);
+  print_main_help(stderr);
+  return 2;
+}

@@ -1,0 +1,244 @@
+/* Vehicle configuration: YAML (libyaml document API) to hm_vehicle, with located error messages. */
+#include "hunting_monitor/config.h"
+
+#include <errno.h>
+#include <math.h>
+#include <stdarg.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <yaml.h>
+
+typedef struct {
+  yaml_document_t *doc;
+  const char *source;
+  char *err;
+  size_t err_len;
+} parse_ctx;
+
+static hm_status fail(parse_ctx *c, const yaml_node_t *node, hm_status st, const char *fmt, ...) {
+  if (c->err && c->err_len > 0) {
+    int used = node ? snprintf(c->err, c->err_len, "%s:%lu: ", c->source, (unsigned long)node->start_mark.line + 1)
+                    : snprintf(c->err, c->err_len, "%s: ", c->source);
+    if (used < 0) used = 0;
+    if ((size_t)used < c->err_len) {
+      va_list ap;
+      va_start(ap, fmt);
+      vsnprintf(c->err + used, c->err_len - (size_t)used, fmt, ap);
+      va_end(ap);
+    }
+  }
+  return st;
+}
+
+static const char *scalar_text(const yaml_node_t *n) { return (const char *)n->data.scalar.value; }
+
+/* Value node of key in a mapping node, or NULL. Duplicate keys are reported by the caller's scan. */
+static yaml_node_t *map_get(parse_ctx *c, yaml_node_t *map, const char *key) {
+  for (yaml_node_pair_t *p = map->data.mapping.pairs.start; p < map->data.mapping.pairs.top; ++p) {
+    yaml_node_t *k = yaml_document_get_node(c->doc, p->key);
+    if (k && k->type == YAML_SCALAR_NODE && strcmp(scalar_text(k), key) == 0)
+      return yaml_document_get_node(c->doc, p->value);
+  }
+  return NULL;
+}
+
+/* Every key of map must be one of allowed (NULL-terminated) and appear once. */
+static hm_status check_keys(parse_ctx *c, yaml_node_t *map, const char *section, const char *const *allowed) {
+  for (yaml_node_pair_t *p = map->data.mapping.pairs.start; p < map->data.mapping.pairs.top; ++p) {
+    yaml_node_t *k = yaml_document_get_node(c->doc, p->key);
+    if (!k || k->type != YAML_SCALAR_NODE) return fail(c, k, HM_EPARSE, "%s: keys must be plain names", section);
+    int known = 0;
+    for (const char *const *a = allowed; *a; ++a) known |= strcmp(*a, scalar_text(k)) == 0;
+    if (!known) return fail(c, k, HM_EPARSE, "%s.%s: unknown key", section, scalar_text(k));
+    for (yaml_node_pair_t *q = map->data.mapping.pairs.start; q < p; ++q) {
+      yaml_node_t *k2 = yaml_document_get_node(c->doc, q->key);
+      if (k2 && k2->type == YAML_SCALAR_NODE && strcmp(scalar_text(k2), scalar_text(k)) == 0)
+        return fail(c, k, HM_EPARSE, "%s.%s: duplicate key", section, scalar_text(k));
+    }
+  }
+  return HM_OK;
+}
+
+static hm_status get_section(parse_ctx *c, yaml_node_t *root, const char *name, yaml_node_t **out) {
+  yaml_node_t *n = map_get(c, root, name);
+  if (!n) return fail(c, NULL, HM_EPARSE, "%s: missing section", name);
+  if (n->type != YAML_MAPPING_NODE) return fail(c, n, HM_EPARSE, "%s: expected a mapping of keys", name);
+  *out = n;
+  return HM_OK;
+}
+
+/* A finite number from a scalar node (strtod accepts 1869, 8.96, 7.99e6). */
+static hm_status node_number(parse_ctx *c, yaml_node_t *n, const char *path, double *out) {
+  if (n->type != YAML_SCALAR_NODE) return fail(c, n, HM_EPARSE, "%s: expected a number", path);
+  const char *s = scalar_text(n);
+  char *end = NULL;
+  errno = 0;
+  const double v = strtod(s, &end);
+  if (end == s || *end != '\0' || errno == ERANGE || !isfinite(v))
+    return fail(c, n, HM_EPARSE, "%s: expected a finite number, got '%s'", path, s);
+  *out = v;
+  return HM_OK;
+}
+
+static hm_status get_number(parse_ctx *c, yaml_node_t *map, const char *section, const char *key, double *out) {
+  char path[96];
+  snprintf(path, sizeof path, "%s.%s", section, key);
+  yaml_node_t *n = map_get(c, map, key);
+  if (!n) return fail(c, map, HM_EPARSE, "%s: missing key", path);
+  return node_number(c, n, path, out);
+}
+
+typedef struct {
+  const char *key;
+  double scale; /* config unit to SI */
+  size_t offset;
+} number_field;
+
+static hm_status parse_vehicle_section(parse_ctx *c, yaml_node_t *sec, hm_vehicle *veh, char *name) {
+  static const char *const allowed[] = {"name", "mass_kg", "yaw_inertia_kg_m2", "contact_half_distance_m",
+                                        "spring_half_distance_m", "rolling_radius_m", "creep_long_n",
+                                        "creep_lat_n", "spring_ratio", "kx_mn_m", "ky_mn_m", NULL};
+  static const number_field fields[] = {
+      {"mass_kg", 1.0, offsetof(hm_vehicle, mass_kg)},
+      {"yaw_inertia_kg_m2", 1.0, offsetof(hm_vehicle, yaw_inertia_kg_m2)},
+      {"contact_half_distance_m", 1.0, offsetof(hm_vehicle, contact_half_distance_m)},
+      {"spring_half_distance_m", 1.0, offsetof(hm_vehicle, spring_half_distance_m)},
+      {"rolling_radius_m", 1.0, offsetof(hm_vehicle, rolling_radius_m)},
+      {"creep_long_n", 1.0, offsetof(hm_vehicle, creep_long_n)},
+      {"creep_lat_n", 1.0, offsetof(hm_vehicle, creep_lat_n)},
+      {"spring_ratio", 1.0, offsetof(hm_vehicle, spring_ratio)},
+      {"kx_mn_m", 1e6, offsetof(hm_vehicle, stiffness_long_n_m)},
+      {"ky_mn_m", 1e6, offsetof(hm_vehicle, stiffness_lat_n_m)},
+  };
+  hm_status st = check_keys(c, sec, "vehicle", allowed);
+  for (size_t i = 0; st == HM_OK && i < sizeof fields / sizeof fields[0]; ++i) {
+    double v;
+    st = get_number(c, sec, "vehicle", fields[i].key, &v);
+    if (st == HM_OK) *(double *)((char *)veh + fields[i].offset) = v * fields[i].scale;
+  }
+  if (st != HM_OK) return st;
+  yaml_node_t *n = map_get(c, sec, "name");
+  name[0] = '\0';
+  if (n) {
+    if (n->type != YAML_SCALAR_NODE) return fail(c, n, HM_EPARSE, "vehicle.name: expected a string");
+    snprintf(name, HM_VEHICLE_NAME_MAX, "%s", scalar_text(n));
+  }
+  return HM_OK;
+}
+
+static hm_status parse_gaussian(parse_ctx *c, yaml_node_t *item, size_t i, hm_gaussian *g) {
+  static const char *const allowed[] = {"amplitude", "center_m", "width_m", NULL};
+  char sec[48];
+  snprintf(sec, sizeof sec, "conicity.gaussians[%zu]", i);
+  if (item->type != YAML_MAPPING_NODE)
+    return fail(c, item, HM_EPARSE, "%s: expected {amplitude, center_m, width_m}", sec);
+  hm_status st = check_keys(c, item, sec, allowed);
+  if (st == HM_OK) st = get_number(c, item, sec, "amplitude", &g->amplitude);
+  if (st == HM_OK) st = get_number(c, item, sec, "center_m", &g->center_m);
+  if (st == HM_OK) st = get_number(c, item, sec, "width_m", &g->width_m);
+  return st;
+}
+
+static hm_status parse_conicity_section(parse_ctx *c, yaml_node_t *sec, hm_conicity *con) {
+  static const char *const allowed[] = {"constant", "gaussians", NULL};
+  hm_status st = check_keys(c, sec, "conicity", allowed);
+  if (st == HM_OK) st = get_number(c, sec, "conicity", "constant", &con->constant);
+  if (st != HM_OK) return st;
+  con->n_terms = 0;
+  yaml_node_t *list = map_get(c, sec, "gaussians");
+  if (!list || (list->type == YAML_SCALAR_NODE && list->data.scalar.length == 0)) return HM_OK;
+  if (list->type != YAML_SEQUENCE_NODE) return fail(c, list, HM_EPARSE, "conicity.gaussians: expected a list");
+  const size_t count = (size_t)(list->data.sequence.items.top - list->data.sequence.items.start);
+  if (count > HM_CONICITY_MAX_TERMS)
+    return fail(c, list, HM_EPARSE, "conicity.gaussians: %zu terms, at most %d supported", count,
+                HM_CONICITY_MAX_TERMS);
+  for (size_t i = 0; i < count; ++i) {
+    yaml_node_t *item = yaml_document_get_node(c->doc, list->data.sequence.items.start[i]);
+    if (!item) return fail(c, list, HM_EPARSE, "conicity.gaussians[%zu]: missing", i);
+    st = parse_gaussian(c, item, i, &con->terms[i]);
+    if (st != HM_OK) return st;
+  }
+  con->n_terms = count;
+  return HM_OK;
+}
+
+static hm_status parse_flange_section(parse_ctx *c, yaml_node_t *sec, hm_vehicle *veh) {
+  static const char *const allowed[] = {"alpha1_n_m3", "alpha2_n_m5", NULL};
+  hm_status st = check_keys(c, sec, "flange", allowed);
+  if (st == HM_OK) st = get_number(c, sec, "flange", "alpha1_n_m3", &veh->flange_alpha1_n_m3);
+  if (st == HM_OK) st = get_number(c, sec, "flange", "alpha2_n_m5", &veh->flange_alpha2_n_m5);
+  return st;
+}
+
+static hm_status parse_document(parse_ctx *c, hm_vehicle *veh, char *name) {
+  yaml_node_t *root = yaml_document_get_root_node(c->doc);
+  if (!root) return fail(c, NULL, HM_EPARSE, "empty document");
+  if (root->type != YAML_MAPPING_NODE) return fail(c, root, HM_EPARSE, "expected a mapping at the top level");
+  yaml_node_t *sv, *sc, *sf;
+  hm_status st = get_section(c, root, "vehicle", &sv);
+  if (st == HM_OK) st = get_section(c, root, "conicity", &sc);
+  if (st == HM_OK) st = get_section(c, root, "flange", &sf);
+  if (st == HM_OK) st = parse_vehicle_section(c, sv, veh, name);
+  if (st == HM_OK) st = parse_conicity_section(c, sc, &veh->conicity);
+  if (st == HM_OK) st = parse_flange_section(c, sf, veh);
+  return st;
+}
+
+hm_status hm_config_parse_vehicle(const char *text, size_t len, const char *source, hm_vehicle *veh, char *name,
+                                  char *err, size_t err_len) {
+  if (!source) source = "<config>";
+  parse_ctx c = {NULL, source, err, err_len};
+  if (!text || !veh) return fail(&c, NULL, HM_EINVAL, "no text or no output");
+  yaml_parser_t parser;
+  yaml_document_t doc;
+  if (!yaml_parser_initialize(&parser)) return fail(&c, NULL, HM_ENOMEM, "cannot initialise the YAML parser");
+  yaml_parser_set_input_string(&parser, (const unsigned char *)text, len);
+  if (!yaml_parser_load(&parser, &doc)) {
+    hm_status st = fail(&c, NULL, HM_EPARSE, "line %lu: YAML syntax error: %s",
+                        (unsigned long)parser.problem_mark.line + 1, parser.problem ? parser.problem : "unknown");
+    yaml_parser_delete(&parser);
+    return st;
+  }
+  c.doc = &doc;
+  hm_vehicle out;
+  hm_vehicle_default(&out);
+  char out_name[HM_VEHICLE_NAME_MAX];
+  hm_status st = parse_document(&c, &out, out_name);
+  if (st == HM_OK) {
+    char why[160];
+    st = hm_vehicle_validate(&out, why, sizeof why);
+    if (st != HM_OK) fail(&c, NULL, st, "%s", why);
+  }
+  yaml_document_delete(&doc);
+  yaml_parser_delete(&parser);
+  if (st != HM_OK) return st;
+  *veh = out;
+  if (name) memcpy(name, out_name, HM_VEHICLE_NAME_MAX);
+  return HM_OK;
+}
+
+hm_status hm_config_load_vehicle(const char *path, hm_vehicle *veh, char *name, char *err, size_t err_len) {
+  parse_ctx c = {NULL, path ? path : "<null>", err, err_len};
+  if (!path) return fail(&c, NULL, HM_EINVAL, "no path");
+  FILE *f = fopen(path, "rb");
+  if (!f) return fail(&c, NULL, HM_EIO, "cannot open: %s", strerror(errno));
+  enum { MAX_CONFIG_BYTES = 1 << 20 };
+  char *buf = malloc(MAX_CONFIG_BYTES + 1);
+  if (!buf) {
+    fclose(f);
+    return fail(&c, NULL, HM_ENOMEM, "out of memory");
+  }
+  const size_t n = fread(buf, 1, MAX_CONFIG_BYTES + 1, f);
+  const int read_error = ferror(f);
+  fclose(f);
+  hm_status st;
+  if (read_error)
+    st = fail(&c, NULL, HM_EIO, "read error");
+  else if (n > MAX_CONFIG_BYTES)
+    st = fail(&c, NULL, HM_EPARSE, "larger than 1 MiB: not a vehicle config");
+  else
+    st = hm_config_parse_vehicle(buf, n, path, veh, name, err, err_len);
+  free(buf);
+  return st;
+}

@@ -1,0 +1,180 @@
+#!/usr/bin/env python3
+"""Tests of the `hunting` command-line tool against MODEL.md's published numbers and independent checks.
+
+Usage: test_cli.py PATH_TO_HUNTING SOURCE_DIR. Prints "PASS name" / "FAIL name" per test (counted by scripts/test).
+"""
+import csv
+import io
+import json
+import math
+import os
+import subprocess
+import sys
+import tempfile
+
+HUNTING = sys.argv[1]
+SRC = sys.argv[2]
+failures = 0
+
+
+def run(*args, ok=True):
+    p = subprocess.run([HUNTING, *args], capture_output=True, text=True, timeout=120)
+    if ok and p.returncode != 0:
+        raise AssertionError(f"hunting {' '.join(args)} exited {p.returncode}: {p.stderr}")
+    return p
+
+
+def run_json(*args):
+    return json.loads(run(*args).stdout)
+
+
+def close(x, ref, tol, what):
+    if not abs(x - ref) <= tol:
+        raise AssertionError(f"{what} = {x!r}, expected {ref!r} +- {tol}")
+
+
+def test_critical_published_speeds():
+    # MODEL.md section 6, lambda = 0.1271
+    for kx, ky, ref in [(8.96, 8.96, 536.634923), (6.96, 8.96, 476.872437), (4.96, 8.96, 428.155705),
+                        (2.96, 8.96, 384.701298), (8.96, 2.96, 554.296633), (8.96, 14.96, 565.303816),
+                        (8.96, 20.96, 635.487135)]:
+        out = run_json("critical", "--kx", str(kx), "--ky", str(ky), "--conicity", "0.1271")
+        close(out["v_crit_kmh"], ref, 1e-3, f"v_crit_kmh kx={kx} ky={ky}")
+    out = run_json("critical", "--kx", "8.96", "--ky", "8.96", "--conicity", "0.1271")
+    eig = sorted(out["eigenvalues"], key=lambda e: (e[0], e[1]))
+    refs = sorted([[-61.5026, 90.8747], [-61.5026, -90.8747], [0.0, 89.7127], [0.0, -89.7127]])
+    for e, r in zip(eig, refs):
+        close(e[0], r[0], 1e-3, "Re eigenvalue")
+        close(e[1], r[1], 1e-3, "Im eigenvalue")
+    close(out["frequency_hz"], 89.7127 / (2 * math.pi), 1e-4, "frequency_hz")
+
+
+def test_critical_default_vehicle_and_config_file():
+    # MODEL.md section 7: default vehicle Hopf at 517.618 km/h; the shipped file gives the same.
+    close(run_json("critical")["v_crit_kmh"], 517.618, 6e-4, "default v_crit_kmh")
+    cfg = os.path.join(SRC, "config", "crh380_default.yaml")
+    close(run_json("critical", "--config", cfg)["v_crit_kmh"], 517.618, 6e-4, "config file v_crit_kmh")
+    # MODEL.md section 6, nonlinear Hopf speeds (Ky = 10.96)
+    for kx, ref in [(9.1, 527.4349), (9.7, 544.3795), (9.9, 550.3513)]:
+        close(run_json("critical", "--kx", str(kx), "--ky", "10.96")["v_crit_kmh"], ref, 1e-3, f"Hopf kx={kx}")
+
+
+def test_critical_conicity_inverts_critical_speed():
+    out = run_json("critical-conicity", "--v", "536.634923", "--kx", "8.96", "--ky", "8.96")
+    close(out["conicity_crit"], 0.1271, 1e-7, "conicity_crit at V0")
+
+
+def test_eig_stability_flips_at_critical_speed():
+    below = run_json("eig", "--v", "517.0")
+    above = run_json("eig", "--v", "518.2")
+    assert below["stable"] is True and above["stable"] is False, (below, above)
+    assert max(e[0] for e in below["eigenvalues"]) < 0 < max(e[0] for e in above["eigenvalues"])
+
+
+def test_simulate_csv_is_consistent():
+    with tempfile.TemporaryDirectory() as d:
+        path = os.path.join(d, "sim.csv")
+        run("simulate", "--v", "543", "--x0", "0.001,0.001,0.006,0.06", "--t", "1", "--dt-out", "0.0001",
+            "--out", path)
+        with open(path) as f:
+            rows = list(csv.DictReader(f))
+    assert len(rows) == 10001, len(rows)
+    assert list(rows[0].keys()) == ["t_s", "y_m", "dy_mps", "psi_rad", "dpsi_radps", "accel_lat_mps2"]
+    close(float(rows[0]["y_m"]), 0.001, 0, "initial y")
+    # Independent checks: dy/dt column against central differences of y, and the acceleration column against
+    # central differences of dy/dt (the model's own derivatives must agree with its trajectory).
+    h = 0.0001
+    worst_v = worst_a = 0.0
+    for i in range(1, len(rows) - 1):
+        dy = (float(rows[i + 1]["y_m"]) - float(rows[i - 1]["y_m"])) / (2 * h)
+        worst_v = max(worst_v, abs(dy - float(rows[i]["dy_mps"])) / 2.0)
+        acc = (float(rows[i + 1]["dy_mps"]) - float(rows[i - 1]["dy_mps"])) / (2 * h)
+        worst_a = max(worst_a, abs(acc - float(rows[i]["accel_lat_mps2"])) / 500.0)
+    assert worst_v < 2e-3 and worst_a < 2e-2, (worst_v, worst_a)
+
+
+def test_simulate_linear_decays_below_critical_speed():
+    # Below the linear critical speed the linear model decays at the rate of its least damped eigenvalue.
+    out = run("simulate", "--linear", "--v", "450", "--x0", "0.001,0,0,0", "--t", "3", "--dt-out", "0.01").stdout
+    rows = list(csv.DictReader(io.StringIO(out)))
+    sigma = max(e[0] for e in run_json("eig", "--v", "450")["eigenvalues"])
+    peak_late = max(abs(float(r["y_m"])) for r in rows if 2.5 <= float(r["t_s"]) <= 3.0)
+    peak_early = max(abs(float(r["y_m"])) for r in rows if 0.5 <= float(r["t_s"]) <= 1.0)
+    rate = math.log(peak_late / peak_early) / 2.0
+    close(rate, sigma, 0.1 * abs(sigma), "decay rate vs least damped eigenvalue")
+
+
+def test_lyapunov_linear_equals_eigenvalues():
+    out = run_json("lyapunov", "--v", "400", "--conicity", "0.22", "--linear", "--t", "200")
+    eig = run_json("eig", "--v", "400", "--conicity", "0.22")
+    re = sorted((e[0] for e in eig["eigenvalues"]), reverse=True)
+    for x, r in zip(out["exponents"], re):
+        close(x, r, 0.03, "Lyapunov exponent vs Re(eigenvalue)")
+
+
+def test_bad_input_gives_clear_errors():
+    cases = [
+        (["critical", "--kx", "-1"], "vehicle.kx_mn_m: must be > 0"),
+        (["critical", "--kx", "abc"], "--kx: expected a finite number"),
+        (["critical", "--conicity", "nan"], "--conicity: expected a finite number"),
+        (["eig"], "--v KM/H (running speed) is required"),
+        (["eig", "--v", "-5"], "--v must be > 0"),
+        (["critical", "--bogus"], "unknown option '--bogus'"),
+        (["critical", "--config", "/nonexistent.yaml"], "cannot open"),
+        (["simulate", "--v", "500", "--x0", "1,2,3"], "expected 4 comma-separated finite numbers"),
+        (["simulate", "--v", "500", "--t", "-1"], "need --t > 0"),
+        (["lyapunov", "--v", "500", "--method", "rk4"], "--method must be midpoint or dopri"),
+        (["frobnicate"], "unknown command 'frobnicate'"),
+        (["critical", "--conicity", "0"], "no critical speed"),
+    ]
+    for args, message in cases:
+        p = run(*args, ok=False)
+        assert p.returncode != 0, f"{args} exited 0"
+        assert message in p.stderr, f"{args}: stderr {p.stderr!r} lacks {message!r}"
+        assert p.stdout == "", f"{args}: printed to stdout on error: {p.stdout!r}"
+    with tempfile.TemporaryDirectory() as d:
+        bad = os.path.join(d, "bad.yaml")
+        with open(os.path.join(SRC, "config", "crh380_default.yaml")) as f:
+            text = f.read().replace("mass_kg: 1869", "mass_kg: -1869")
+        with open(bad, "w") as f:
+            f.write(text)
+        p = run("critical", "--config", bad, ok=False)
+        assert p.returncode != 0 and "vehicle.mass_kg: must be > 0" in p.stderr, p.stderr
+
+
+def test_help_is_available():
+    p = run("--help")
+    assert "critical" in p.stdout and "simulate" in p.stdout
+    for cmd in ["critical", "critical-conicity", "eig", "simulate", "lyapunov", "sweep"]:
+        p = run(cmd, "--help")
+        assert p.stdout.startswith(f"usage: hunting {cmd}"), p.stdout
+    assert run(ok=False).returncode == 2
+
+
+def test_sweep_matches_critical():
+    out = run_json("sweep", "--from", "0.1", "--to", "0.3", "--n", "3")
+    for row in out["rows"]:
+        ref = run_json("critical", "--conicity", str(row["conicity"]))["v_crit_kmh"]
+        close(row["v_crit_kmh"], ref, 1e-9, "sweep row")
+    # Critical speed falls with conicity (Klingel: frequency ~ v sqrt(lambda)).
+    speeds = [r["v_crit_kmh"] for r in out["rows"]]
+    assert speeds[0] > speeds[1] > speeds[2], speeds
+
+
+def main():
+    global failures
+    tests = [(n, f) for n, f in globals().items() if n.startswith("test_") and callable(f)]
+    for name, fn in tests:
+        try:
+            fn()
+            print(f"PASS {name}")
+        except Exception as e:  # noqa: BLE001 - report every failure and go on
+            failures += 1
+            print(f"  {type(e).__name__}: {e}")
+            print(f"FAIL {name}")
+        sys.stdout.flush()
+    return 1 if failures else 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,147 @@
+/* Vehicle config: the shipped file holds MODEL.md's values; every malformed config gets a located error. */
+#include <string.h>
+
+#include "hm_test.h"
+#include "hunting_monitor/config.h"
+
+static const char *VALID =
+    "vehicle:\n"
+    "  name: test\n"
+    "  mass_kg: 1869\n"
+    "  yaw_inertia_kg_m2: 910\n"
+    "  contact_half_distance_m: 0.7465\n"
+    "  spring_half_distance_m: 1.0\n"
+    "  rolling_radius_m: 0.43\n"
+    "  creep_long_n: 7.99e6\n"
+    "  creep_lat_n: 7.99e6\n"
+    "  spring_ratio: 1.351186\n"
+    "  kx_mn_m: 9.7\n"
+    "  ky_mn_m: 10.96\n"
+    "conicity:\n"
+    "  constant: 0.1358\n"
+    "  gaussians:\n"
+    "    - {amplitude: 0.7, center_m: 0.01, width_m: 0.00145}\n"
+    "    - {amplitude: 0.7, center_m: -0.01, width_m: 0.00145}\n"
+    "flange:\n"
+    "  alpha1_n_m3: -1.6e11\n"
+    "  alpha2_n_m5: 1.6e15\n"
+    "monitor:\n"
+    "  anything: 1\n";
+
+static void shipped_config_holds_model_values(void) {
+  hm_vehicle v;
+  char name[HM_VEHICLE_NAME_MAX], err[256] = "";
+  const hm_status st = hm_config_load_vehicle(HM_SOURCE_DIR "/config/crh380_default.yaml", &v, name, err, sizeof err);
+  HM_CHECK(st == HM_OK, "load: %s", err);
+  HM_CHECK(strcmp(name, "crh380_default") == 0, "name '%s'", name);
+  /* MODEL.md section 2 and 3, in SI. */
+  HM_CHECK(v.mass_kg == 1869 && v.yaw_inertia_kg_m2 == 910 && v.contact_half_distance_m == 0.7465, "m, I, d0");
+  HM_CHECK(v.spring_half_distance_m == 1.0 && v.rolling_radius_m == 0.43, "d1, r0");
+  HM_CHECK(v.creep_long_n == 7.99e6 && v.creep_lat_n == 7.99e6 && v.spring_ratio == 1.351186, "kx, ky, l0/l1");
+  HM_CHECK_DELTA(v.stiffness_long_n_m, 8.96e6, 1e-6, "Kx [N/m]");
+  HM_CHECK_DELTA(v.stiffness_lat_n_m, 8.96e6, 1e-6, "Ky [N/m]");
+  HM_CHECK(v.conicity.constant == 0.1358 && v.conicity.n_terms == 2, "conicity constant, terms");
+  HM_CHECK(v.conicity.terms[0].amplitude == 0.7 && v.conicity.terms[0].center_m == 0.01 &&
+               v.conicity.terms[0].width_m == 0.00145 && v.conicity.terms[1].center_m == -0.01,
+           "Gaussian terms");
+  HM_CHECK(v.flange_alpha1_n_m3 == -1.6e11 && v.flange_alpha2_n_m5 == 1.6e15, "flange");
+  /* and it is what the library calls its default */
+  hm_vehicle d;
+  hm_vehicle_default(&d);
+  HM_CHECK(v.mass_kg == d.mass_kg && fabs(v.stiffness_long_n_m - d.stiffness_long_n_m) < 1e-6 &&
+               v.conicity.constant == d.conicity.constant && v.flange_alpha2_n_m5 == d.flange_alpha2_n_m5,
+           "shipped file and hm_vehicle_default differ");
+}
+
+static void valid_text_parses_with_units(void) {
+  hm_vehicle v;
+  char err[256] = "";
+  HM_CHECK(hm_config_parse_vehicle(VALID, strlen(VALID), "t", &v, NULL, err, sizeof err) == HM_OK, "%s", err);
+  HM_CHECK_DELTA(v.stiffness_long_n_m, 9.7e6, 1e-6, "kx_mn_m 9.7 -> N/m");
+  HM_CHECK_DELTA(v.stiffness_lat_n_m, 10.96e6, 1e-6, "ky_mn_m 10.96 -> N/m");
+}
+
+/* Replace the first occurrence of `from` in VALID by `to`. */
+static void variant(char *out, size_t len, const char *from, const char *to) {
+  const char *p = strstr(VALID, from);
+  if (!p) {
+    snprintf(out, len, "%s", VALID);
+    printf("  test bug: '%s' not in the valid text\n", from);
+    hm_test_case_failed = 1;
+    return;
+  }
+  snprintf(out, len, "%.*s%s%s", (int)(p - VALID), VALID, to, p + strlen(from));
+}
+
+typedef struct {
+  const char *from, *to;
+  hm_status status;
+  const char *message; /* expected substring */
+} bad_case;
+
+static void malformed_configs_get_clear_errors(void) {
+  const bad_case cases[] = {
+      {"  mass_kg: 1869\n", "", HM_EPARSE, "vehicle.mass_kg: missing key"},
+      {"  mass_kg: 1869\n", "  mass_kg: -1869\n", HM_EDOMAIN, "vehicle.mass_kg: must be > 0"},
+      {"  mass_kg: 1869\n", "  mass_kg: heavy\n", HM_EPARSE, "t:3: vehicle.mass_kg: expected a finite number"},
+      {"  mass_kg: 1869\n", "  mass_kg: .nan\n", HM_EPARSE, "vehicle.mass_kg: expected a finite number"},
+      {"  mass_kg: 1869\n", "  mass_kg: nan\n", HM_EPARSE, "vehicle.mass_kg: expected a finite number"},
+      {"  mass_kg: 1869\n", "  mass_kg: 1e999\n", HM_EPARSE, "vehicle.mass_kg: expected a finite number"},
+      {"  mass_kg: 1869\n", "  mass_kg: [1869]\n", HM_EPARSE, "vehicle.mass_kg: expected a number"},
+      {"  mass_kg: 1869\n", "  mass_kg: 1869\n  mass_kg: 1870\n", HM_EPARSE, "vehicle.mass_kg: duplicate key"},
+      {"  mass_kg: 1869\n", "  mas_kg: 1869\n", HM_EPARSE, "vehicle.mas_kg: unknown key"},
+      {"  kx_mn_m: 9.7\n", "  kx_mn_m: 0\n", HM_EDOMAIN, "vehicle.kx_mn_m: must be > 0"},
+      {"  yaw_inertia_kg_m2: 910\n", "  yaw_inertia_kg_m2: 0\n", HM_EDOMAIN, "vehicle.yaw_inertia_kg_m2"},
+      {"  rolling_radius_m: 0.43\n", "  rolling_radius_m: -0.43\n", HM_EDOMAIN, "vehicle.rolling_radius_m"},
+      {"width_m: 0.00145}\n    - {", "width_m: 0}\n    - {", HM_EDOMAIN, "conicity.gaussians[0].width_m"},
+      {"width_m: 0.00145}\n    - {", "width: 0.00145}\n    - {", HM_EPARSE, "conicity.gaussians[0].width: unknown"},
+      {"center_m: -0.01, ", "", HM_EPARSE, "conicity.gaussians[1].center_m: missing key"},
+      {"  constant: 0.1358\n", "", HM_EPARSE, "conicity.constant: missing key"},
+      {"  gaussians:\n", "  gaussians: 3\n  other:\n", HM_EPARSE, "conicity.other: unknown key"},
+      {"flange:\n  alpha1_n_m3: -1.6e11\n  alpha2_n_m5: 1.6e15\n", "", HM_EPARSE, "flange: missing section"},
+      {"conicity:\n  constant", "conicity: 3\nx:\n  constant", HM_EPARSE, "conicity: expected a mapping"},
+      {"  name: test\n", "  name: test\n   bad_indent: 1\n", HM_EPARSE, "YAML syntax error"},
+      {"  alpha2_n_m5: 1.6e15\n", "  alpha2_n_m5: 1.6e15\n  - x\n", HM_EPARSE, "YAML syntax error"},
+  };
+  for (size_t i = 0; i < sizeof cases / sizeof cases[0]; ++i) {
+    char text[4096], err[256] = "";
+    variant(text, sizeof text, cases[i].from, cases[i].to);
+    hm_vehicle v;
+    memset(&v, 0x11, sizeof v);
+    const hm_vehicle before = v;
+    const hm_status st = hm_config_parse_vehicle(text, strlen(text), "t", &v, NULL, err, sizeof err);
+    HM_CHECK(st == cases[i].status, "case %zu: status '%s', expected '%s' (%s)", i, hm_status_str(st),
+             hm_status_str(cases[i].status), err);
+    HM_CHECK(strstr(err, cases[i].message) != NULL, "case %zu: message '%s' lacks '%s'", i, err, cases[i].message);
+    HM_CHECK(memcmp(&v, &before, sizeof v) == 0, "case %zu: output changed on failure", i);
+  }
+}
+
+static void degenerate_documents(void) {
+  hm_vehicle v;
+  char err[256] = "";
+  HM_CHECK(hm_config_parse_vehicle("", 0, "t", &v, NULL, err, sizeof err) == HM_EPARSE, "empty");
+  HM_CHECK(strstr(err, "empty document") != NULL, "message '%s'", err);
+  HM_CHECK(hm_config_parse_vehicle("- 1\n- 2\n", 8, "t", &v, NULL, err, sizeof err) == HM_EPARSE, "list");
+  HM_CHECK(strstr(err, "expected a mapping at the top level") != NULL, "message '%s'", err);
+  char many[8192];
+  int n = snprintf(many, sizeof many, "%s", VALID);
+  char *g = strstr(many, "  gaussians:\n");
+  n = (int)(g - many);
+  n += snprintf(many + n, sizeof many - (size_t)n, "  gaussians:\n");
+  for (int i = 0; i < 9; ++i)
+    n += snprintf(many + n, sizeof many - (size_t)n, "    - {amplitude: 0.1, center_m: 0.0, width_m: 0.001}\n");
+  snprintf(many + n, sizeof many - (size_t)n, "flange:\n  alpha1_n_m3: 0\n  alpha2_n_m5: 0\n");
+  HM_CHECK(hm_config_parse_vehicle(many, strlen(many), "t", &v, NULL, err, sizeof err) == HM_EPARSE, "9 terms");
+  HM_CHECK(strstr(err, "at most 8") != NULL, "message '%s'", err);
+  HM_CHECK(hm_config_load_vehicle("/nonexistent/vehicle.yaml", &v, NULL, err, sizeof err) == HM_EIO, "missing file");
+  HM_CHECK(strstr(err, "/nonexistent/vehicle.yaml: cannot open") != NULL, "message '%s'", err);
+}
+
+int main(void) {
+  HM_RUN(shipped_config_holds_model_values);
+  HM_RUN(valid_text_parses_with_units);
+  HM_RUN(malformed_configs_get_clear_errors);
+  HM_RUN(degenerate_documents);
+  HM_TEST_EXIT();
+}
