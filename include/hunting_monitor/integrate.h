@@ -93,6 +93,9 @@ hm_status hm_dopri_integrate(hm_dopri integ, const hm_ode_system *sys, const hm_
  * integration). HM_EINVAL if t is outside [t_old, t_new] of that step by more than 1e-12 of its length. */
 hm_status hm_dopri_dense(const hm_dopri integ, double t, double *x_out);
 
+/* Dense output of components [first, first + count) only (for cheap monitoring of a few states). */
+hm_status hm_dopri_dense_partial(const hm_dopri integ, double t, size_t first, size_t count, double *x_out);
+
 /* ---- implicit midpoint rule ---- */
 
 typedef struct hm_midpoint_s *hm_midpoint;

@@ -95,11 +95,35 @@ hm_status hm_vehicle_set_conicity_at_zero(hm_vehicle *veh, double conicity0);
 /* lambda(y) and dlambda/dy [1/m]; either output may be NULL. */
 void hm_conicity_eval(const hm_conicity *con, double y_m, double *lambda, double *dlambda_dy);
 
+/* Derivatives d^j lambda / dy^j at y for j = 0..kmax (kmax <= 8) into d[0..kmax], by Hermite polynomials:
+ * d^j/dy^j exp(-u^2) = (-1)^j H_j(u) exp(-u^2) / c^j with u = (y - b)/c. */
+void hm_conicity_derivatives(const hm_conicity *con, double y_m, int kmax, double *d);
+
 /* F_T(y) [N] and dF_T/dy [N/m]; either output may be NULL. */
 void hm_flange_force(const hm_vehicle *veh, double y_m, double *force_n, double *dforce_dy);
 
 /* Derive the linear coefficients (no validation: call hm_vehicle_validate first). */
 void hm_linear_coef_from_vehicle(const hm_vehicle *veh, hm_linear_coef *coef);
+
+/* The parameters a bifurcation analysis can vary, in user units. */
+typedef enum {
+  HM_PARAM_SPEED = 0,    /* running speed V [km/h] */
+  HM_PARAM_KX = 1,       /* primary longitudinal stiffness Kx [MN/m] */
+  HM_PARAM_KY = 2,       /* primary lateral stiffness Ky [MN/m] */
+  HM_PARAM_CONICITY = 3  /* equivalent conicity at y = 0, lambda(0) (shifts the constant term) */
+} hm_param;
+
+/* "v_kmh", "kx_mn_m", "ky_mn_m", "conicity"; NULL for an unknown parameter. */
+const char *hm_param_name(hm_param p);
+/* Parse one of the names above or the short forms "v", "kx", "ky", "conicity"; HM_EINVAL if unknown. */
+hm_status hm_param_from_name(const char *name, hm_param *p);
+/* Value of parameter p of (veh, speed_kmh) in user units. */
+double hm_param_get(const hm_vehicle *veh, double speed_kmh, hm_param p);
+/* Set parameter p to value (user units) in *veh or *speed_kmh. HM_EDOMAIN for a non-finite or out-of-domain
+ * value (speed or Kx <= 0, Ky or conicity < 0); outputs untouched on failure. */
+hm_status hm_param_set(hm_vehicle *veh, double *speed_kmh, hm_param p, double value);
+/* df/dp at state x for the model mdl, with p in user units (per km/h, per MN/m, per unit conicity). */
+void hm_model_dparam(const hm_model *mdl, hm_param p, const double *x, double *dfdp);
 
 /* Validate veh and speed (finite, > 0) and fill mdl. mdl untouched on failure. */
 hm_status hm_model_init(hm_model *mdl, const hm_vehicle *veh, double speed_mps);

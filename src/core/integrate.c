@@ -139,14 +139,21 @@ static void dopri_store_dense(hm_dopri d, double t, double h) {
   d->have_dense = 1;
 }
 
-hm_status hm_dopri_dense(const hm_dopri d, double t, double *x_out) {
-  if (!d || !x_out || !d->have_dense) return HM_EINVAL;
+hm_status hm_dopri_dense_partial(const hm_dopri d, double t, size_t first, size_t count, double *x_out) {
+  if (!d || !x_out || !d->have_dense || first + count > d->dim || first + count < first) return HM_EINVAL;
   const double theta = (t - d->t_old) / d->h_last;
   if (!(theta >= -1e-12 && theta <= 1.0 + 1e-12)) return HM_EINVAL;
   const double theta1 = 1.0 - theta;
-  for (size_t i = 0; i < d->dim; ++i)
-    x_out[i] = d->r1[i] + theta * (d->r2[i] + theta1 * (d->r3[i] + theta * (d->r4[i] + theta1 * d->r5[i])));
+  for (size_t k = 0; k < count; ++k) {
+    const size_t i = first + k;
+    x_out[k] = d->r1[i] + theta * (d->r2[i] + theta1 * (d->r3[i] + theta * (d->r4[i] + theta1 * d->r5[i])));
+  }
   return HM_OK;
+}
+
+hm_status hm_dopri_dense(const hm_dopri d, double t, double *x_out) {
+  if (!d) return HM_EINVAL;
+  return hm_dopri_dense_partial(d, t, 0, d->dim, x_out);
 }
 
 /* Hairer's starting-step heuristic (Solving ODEs I, II.4) with one explicit Euler probe. */

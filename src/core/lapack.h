@@ -3,6 +3,7 @@
 #ifndef HM_CORE_LAPACK_H
 #define HM_CORE_LAPACK_H
 
+#include <complex.h>
 #include <stddef.h>
 
 void dgeev_(const char *jobvl, const char *jobvr, const int *n, double *a, const int *lda, double *wr, double *wi,
@@ -13,5 +14,8 @@ void dgeqrf_(const int *m, const int *n, double *a, const int *lda, double *tau,
              int *info);
 void dorgqr_(const int *m, const int *n, const int *k, double *a, const int *lda, const double *tau, double *work,
              const int *lwork, int *info);
+
+void zgesv_(const int *n, const int *nrhs, double _Complex *a, const int *lda, int *ipiv, double _Complex *b,
+            const int *ldb, int *info);
 
 #endif

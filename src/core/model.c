@@ -104,6 +104,26 @@ void hm_conicity_eval(const hm_conicity *con, double y_m, double *lambda, double
   if (dlambda_dy) *dlambda_dy = dl;
 }
 
+void hm_conicity_derivatives(const hm_conicity *con, double y_m, int kmax, double *d) {
+  if (kmax > 8) kmax = 8;
+  for (int j = 0; j <= kmax; ++j) d[j] = 0.0;
+  d[0] = con->constant;
+  for (size_t i = 0; i < con->n_terms; ++i) {
+    const hm_gaussian *g = &con->terms[i];
+    const double u = (y_m - g->center_m) / g->width_m;
+    const double e = g->amplitude * exp(-u * u);
+    double h_prev = 1.0, h = 2.0 * u, scale = 1.0; /* H_0, H_1, c^-j */
+    d[0] += e;
+    for (int j = 1; j <= kmax; ++j) {
+      scale /= -g->width_m;
+      d[j] += h * scale * e;
+      const double h_next = 2.0 * u * h - 2.0 * j * h_prev;
+      h_prev = h;
+      h = h_next;
+    }
+  }
+}
+
 void hm_vehicle_linearized(const hm_vehicle *veh, hm_vehicle *linear) {
   hm_vehicle out = *veh;
   double lambda0;
@@ -143,6 +163,82 @@ void hm_linear_coef_from_vehicle(const hm_vehicle *veh, hm_linear_coef *coef) {
   coef->e_yaw_m_s2 = 2.0 * d0 * veh->creep_long_n / (I * veh->rolling_radius_m);
   coef->f1_m2_s2 = veh->flange_alpha1_n_m3 / m;
   coef->f2_m4_s2 = veh->flange_alpha2_n_m5 / m;
+}
+
+const char *hm_param_name(hm_param p) {
+  switch (p) {
+    case HM_PARAM_SPEED: return "v_kmh";
+    case HM_PARAM_KX: return "kx_mn_m";
+    case HM_PARAM_KY: return "ky_mn_m";
+    case HM_PARAM_CONICITY: return "conicity";
+  }
+  return NULL;
+}
+
+hm_status hm_param_from_name(const char *name, hm_param *p) {
+  static const struct {
+    const char *name;
+    hm_param p;
+  } names[] = {{"v", HM_PARAM_SPEED},   {"v_kmh", HM_PARAM_SPEED}, {"kx", HM_PARAM_KX},
+               {"kx_mn_m", HM_PARAM_KX}, {"ky", HM_PARAM_KY},       {"ky_mn_m", HM_PARAM_KY},
+               {"conicity", HM_PARAM_CONICITY}};
+  if (!name || !p) return HM_EINVAL;
+  for (size_t i = 0; i < sizeof names / sizeof names[0]; ++i)
+    if (strcmp(name, names[i].name) == 0) {
+      *p = names[i].p;
+      return HM_OK;
+    }
+  return HM_EINVAL;
+}
+
+double hm_param_get(const hm_vehicle *veh, double speed_kmh, hm_param p) {
+  double l0;
+  switch (p) {
+    case HM_PARAM_SPEED: return speed_kmh;
+    case HM_PARAM_KX: return veh->stiffness_long_n_m * 1e-6;
+    case HM_PARAM_KY: return veh->stiffness_lat_n_m * 1e-6;
+    case HM_PARAM_CONICITY: hm_conicity_eval(&veh->conicity, 0.0, &l0, NULL); return l0;
+  }
+  return NAN;
+}
+
+hm_status hm_param_set(hm_vehicle *veh, double *speed_kmh, hm_param p, double value) {
+  if (!veh || !speed_kmh) return HM_EINVAL;
+  if (!isfinite(value)) return HM_EDOMAIN;
+  switch (p) {
+    case HM_PARAM_SPEED:
+      if (value <= 0.0) return HM_EDOMAIN;
+      *speed_kmh = value;
+      return HM_OK;
+    case HM_PARAM_KX:
+      if (value <= 0.0) return HM_EDOMAIN;
+      veh->stiffness_long_n_m = value * 1e6;
+      return HM_OK;
+    case HM_PARAM_KY:
+      if (value < 0.0) return HM_EDOMAIN;
+      veh->stiffness_lat_n_m = value * 1e6;
+      return HM_OK;
+    case HM_PARAM_CONICITY: return hm_vehicle_set_conicity_at_zero(veh, value);
+  }
+  return HM_EINVAL;
+}
+
+void hm_model_dparam(const hm_model *mdl, hm_param p, const double *x, double *dfdp) {
+  const hm_vehicle *v = &mdl->vehicle;
+  const double speed = mdl->speed_mps;
+  dfdp[0] = dfdp[1] = dfdp[2] = dfdp[3] = 0.0;
+  switch (p) {
+    case HM_PARAM_SPEED: /* d/dV of -c/v terms, v = V/3.6 */
+      dfdp[1] = mdl->coef.c_lat_m_s2 / (speed * speed) * x[1] / 3.6;
+      dfdp[3] = mdl->coef.c_yaw_m_s2 / (speed * speed) * x[3] / 3.6;
+      break;
+    case HM_PARAM_KX:
+      dfdp[1] = -1e6 * (v->spring_ratio - 1.0) / v->mass_kg * x[0];
+      dfdp[3] = -1e6 * v->spring_half_distance_m * v->spring_half_distance_m / v->yaw_inertia_kg_m2 * x[2];
+      break;
+    case HM_PARAM_KY: dfdp[1] = -1e6 / v->mass_kg * x[0]; break;
+    case HM_PARAM_CONICITY: dfdp[3] = -mdl->coef.e_yaw_m_s2 * x[0]; break;
+  }
 }
 
 hm_status hm_model_init(hm_model *mdl, const hm_vehicle *veh, double speed_mps) {

@@ -1,0 +1,112 @@
+/*
+ * hunting_monitor - limit cycles of the wheelset model: shooting, Floquet multipliers, pseudo-arclength
+ * continuation of the family born at a Hopf point, and its folds (LPC), symmetry-breaking branch points
+ * (BPC), period doublings (PD) and Neimark-Sacker points (NS).
+ *
+ * Method: single shooting with the variational equations, not orthogonal collocation. The model is 4-D,
+ * smooth and non-stiff with a cheap right-hand side and periods of about 0.07 s whose Floquet multipliers
+ * stay within about 1e-3..1e2, so one shooting interval is well conditioned; the variational equations
+ * (integrated with Dormand-Prince 5(4) to rtol) give the monodromy matrix and hence the multipliers exactly
+ * to integration accuracy, Newton's matrix is only 5x5 (LAPACK dgesv), and the integrator's error control
+ * replaces mesh adaptation. The model is odd (f(-x) = -f(x)) when lambda(y) is even; its symmetric cycles
+ * satisfy x(t + T/2) = -x(t), so half a period is shot with the condition x(T/2) = -x(0) (half the cost), and
+ * R = -Phi(T/2) gives the multipliers as eig(R)^2 and separates folds (an eigenvalue of R at +1) from
+ * symmetry-breaking branch points (an eigenvalue of R at -1).
+ *
+ * Unknowns: u = (y0, psi0, dpsi0, T, p), the start point on the section dy/dt = 0 (the phase condition), the
+ * period and the parameter; continuation in scaled units (mm, mrad, 0.1 rad/s, 10 ms, and 1 km/h, 0.03 MN/m or
+ * 0.001 of conicity), so the arclength step is measured in "millimetres and km/h".
+ */
+#ifndef HUNTING_MONITOR_CYCLES_H
+#define HUNTING_MONITOR_CYCLES_H
+
+#include <stddef.h>
+
+#include "hunting_monitor/hopf.h"
+#include "hunting_monitor/model.h"
+#include "hunting_monitor/status.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+typedef struct {
+  hm_param param;           /* continuation parameter */
+  double p_min, p_max;      /* stop when the parameter leaves [p_min, p_max] (user units) */
+  double amp_max_m;         /* stop when max|y| exceeds this [m] */
+  double amp_start_m;       /* max|y| of the first cycle computed near the Hopf point [m] */
+  double ds_init, ds_min, ds_max; /* arclength steps (scaled units, see above) */
+  size_t max_steps;         /* continuation step limit */
+  double rtol, atol;        /* shooting integration tolerances */
+  double newton_tol;        /* Newton stops when the scaled update is below this (max norm) */
+  size_t newton_max_iter;
+  double locate_tol;        /* events are located to this arclength (scaled units) */
+  int use_symmetry;         /* 1: half-period shooting when the vehicle is odd-symmetric; 0: never */
+} hm_cycle_options;
+
+/* Defaults for parameter p: a wide range, 20 mm amplitude limit, ds 0.05..5, 2000 steps, rtol 1e-10,
+ * atol 1e-13, Newton 1e-9 (8 iterations), location to 1e-9, symmetry on. */
+void hm_cycle_options_default(hm_cycle_options *opt, hm_param p);
+
+typedef struct {
+  double param;             /* parameter value (user units) */
+  double period_s;
+  double amp_y_m;           /* max |y| over the cycle */
+  double amp_psi_rad;       /* max |psi| over the cycle */
+  double x0[4];             /* the cycle's point with dy/dt = 0 (and y > 0) */
+  double mult_re[4], mult_im[4]; /* Floquet multipliers, by decreasing modulus; the trivial one included */
+  int trivial_index;        /* index of the trivial multiplier (closest to +1) */
+  int n_unstable;           /* non-trivial multipliers outside the unit circle */
+  int stable;               /* 1 if n_unstable == 0 */
+  double dparam_ds;         /* parameter component of the unit tangent (scaled): folds where it changes sign */
+} hm_cycle_point;
+
+typedef enum {
+  HM_CYCLE_LPC = 0,  /* fold (limit point) of cycles */
+  HM_CYCLE_BPC = 1,  /* branch point: a real multiplier crosses +1 without a fold (symmetry breaking) */
+  HM_CYCLE_PD = 2,   /* period doubling: a real multiplier crosses -1 */
+  HM_CYCLE_NS = 3    /* Neimark-Sacker: a complex pair crosses the unit circle */
+} hm_cycle_event_kind;
+
+typedef struct {
+  hm_cycle_event_kind kind;
+  size_t index;             /* the event lies between branch points index - 1 and index */
+  hm_cycle_point point;     /* located point */
+  int stable_side;          /* LPC: +1 if the stable cycles lie at larger parameter values, -1 smaller, 0 none */
+} hm_cycle_event;
+
+const char *hm_cycle_event_name(hm_cycle_event_kind kind); /* "LPC", "BPC", "PD", "NS" */
+
+/* Whether lambda(y) is even (every Gaussian term has a mirror term with equal amplitude and width) so that
+ * the model is odd-symmetric; relative tolerance tol on the term values. */
+int hm_conicity_is_even(const hm_conicity *con, double tol);
+
+/*
+ * Continue the family of cycles born at the Hopf point `hopf` (found with hm_hopf_find for opt->param; the
+ * other parameters are those of veh and speed_kmh). The first cycle is solved at max|y| = amp_start_m, the
+ * second at twice that, then pseudo-arclength continuation runs until a stop condition: parameter range,
+ * amplitude limit, step limit, or a step that cannot converge even at ds_min. Events are detected between
+ * consecutive points (LPC: sign change of dparam_ds; BPC: of det(I - Phi(T/2)) for symmetric cycles, or of the
+ * product of (mu - 1) over the non-trivial real multipliers otherwise; PD: of det(M + I); NS: change in the
+ * number of complex multipliers outside the unit circle) and located by Brent's method along the arclength.
+ * Writes up to max_points points and max_events events; *n_points and *n_events count those written.
+ * *stop_reason (may be NULL) receives a static string saying why the continuation ended.
+ * Returns HM_OK if at least two points were computed; otherwise the error that prevented it.
+ */
+hm_status hm_cycles_continue(const hm_vehicle *veh, double speed_kmh, const hm_hopf_point *hopf,
+                             const hm_cycle_options *opt, hm_cycle_point *points, size_t max_points,
+                             size_t *n_points, hm_cycle_event *events, size_t max_events, size_t *n_events,
+                             const char **stop_reason);
+
+/*
+ * One cycle at fixed parameter value p near the guess (x0 with dy/dt = 0, period) by Newton's method on the
+ * shooting equations (opt gives tolerances and symmetry). HM_ENOCONV if Newton does not converge.
+ */
+hm_status hm_cycle_solve(const hm_vehicle *veh, double speed_kmh, const hm_cycle_options *opt, double p,
+                         const double x0_guess[4], double period_guess_s, hm_cycle_point *cycle);
+
+#ifdef __cplusplus
+}
+#endif
+
+#endif
