@@ -105,6 +105,42 @@ hm_status hm_cycles_continue(const hm_vehicle *veh, double speed_kmh, const hm_h
 hm_status hm_cycle_solve(const hm_vehicle *veh, double speed_kmh, const hm_cycle_options *opt, double p,
                          const double x0_guess[4], double period_guess_s, hm_cycle_point *cycle);
 
+/* ---- two-parameter continuation of folds of cycles (LPC curves) and their cusps (CPC) ---- */
+
+typedef struct {
+  hm_param param2;          /* the second parameter (the first is the cycle options' param) */
+  double p2_min, p2_max;    /* stop when it leaves this range */
+  double amp_min_m;         /* stop when the fold cycle shrinks below this (the curve ends at a GH point) */
+  double ds_init, ds_min, ds_max; /* arclength steps (scaled units) */
+  size_t max_steps;         /* per direction */
+  double fd_step;           /* forward-difference step of the fold test's gradient (scaled units) */
+} hm_lpc_options;
+
+/* Defaults: p2 in [0.1, 100] (or conicity [0.001, 2]), amp_min 0.5 mm, ds 0.1..5, 400 steps, fd 1e-6. */
+void hm_lpc_options_default(hm_lpc_options *opt, hm_param param2);
+
+typedef struct {
+  double p1, p2;            /* the two parameters (user units) */
+  double amp_y_m;           /* max |y| of the fold cycle */
+  double period_s;
+  double x0[4];
+  double dp1_ds, dp2_ds;    /* tangent components (scaled) */
+} hm_lpc_point;
+
+/*
+ * Continue the fold of cycles `fold` (an LPC event from hm_cycles_continue with copt, at the p2 of veh and
+ * speed_kmh) in the two parameters (copt->param, lopt->param2), in both directions. Unknowns: the cycle, p1 and
+ * p2; equations: the shooting equations, the fold condition det(d res / d(y0, psi0, dpsi0, T)) = 0 (its
+ * gradient by forward differences), and the pseudo-arclength condition. Cusp points (CPC) are where dp2/ds
+ * changes sign along the curve, located by Brent's method. points (ordered along the curve) and cusps receive
+ * up to max_points / max_cusps entries; counts in *n_points, *n_cusps. stop_reasons[0..1] (may be NULL) say why
+ * each direction ended.
+ */
+hm_status hm_lpc_curve(const hm_vehicle *veh, double speed_kmh, const hm_cycle_options *copt,
+                       const hm_lpc_options *lopt, const hm_cycle_event *fold, hm_lpc_point *points,
+                       size_t max_points, size_t *n_points, hm_lpc_point *cusps, size_t max_cusps,
+                       size_t *n_cusps, const char *stop_reasons[2]);
+
 #ifdef __cplusplus
 }
 #endif

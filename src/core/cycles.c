@@ -9,12 +9,7 @@
 #include "hunting_monitor/linear.h"
 #include "hunting_monitor/roots.h"
 #include "lapack.h"
-
-#define NX 4            /* state dimension */
-#define NU 5            /* unknowns: y0, psi0, dpsi0, T, p */
-#define NZ (NX + NX * NX + NX) /* state, monodromy columns, parameter sensitivity */
-
-static const double RES_SCALE[NX] = {1e-3, 1e-1, 1e-3, 1e-1};
+#include "shooting.h"
 
 const char *hm_cycle_event_name(hm_cycle_event_kind kind) {
   switch (kind) {
@@ -60,110 +55,10 @@ int hm_conicity_is_even(const hm_conicity *con, double tol) {
   return 1;
 }
 
-/* ---- shooting ---- */
-
-typedef struct {
-  hm_vehicle base;
-  double base_speed_kmh;
-  hm_param param;
-  int symmetric;
-  const hm_cycle_options *opt;
-  hm_dopri integ;
-  hm_model model;
-  double sc[NU];         /* scale of each unknown */
-  double amp_y, amp_psi; /* running maxima during an integration */
-} cyc;
-
-/* One evaluation of the shooting map at u. */
-typedef struct {
-  double u[NU];
-  double res[NX];        /* x(tau) - sigma x0 (unscaled) */
-  double jac[NX * NU];   /* d res / d u, row-major (unscaled) */
-  double phi[NX * NX];   /* Phi(tau), column-major */
-  double amp_y, amp_psi;
-} shot;
-
-static hm_status aug_rhs(double t, const double *z, double *dz, void *ctx) {
-  cyc *c = (cyc *)ctx;
-  double J[NX * NX], dfdp[NX];
-  hm_status st = hm_model_rhs(t, z, dz, &c->model);
-  if (st != HM_OK) return st;
-  hm_model_jacobian(t, z, J, &c->model);
-  hm_model_dparam(&c->model, c->param, z, dfdp);
-  for (int col = 0; col <= NX; ++col) { /* NX monodromy columns, then the parameter sensitivity */
-    const double *v = z + NX + NX * col;
-    double *dv = dz + NX + NX * col;
-    for (int i = 0; i < NX; ++i) {
-      const double *Ji = J + NX * i;
-      dv[i] = Ji[0] * v[0] + Ji[1] * v[1] + Ji[2] * v[2] + Ji[3] * v[3] + (col == NX ? dfdp[i] : 0.0);
-    }
-  }
-  return HM_OK;
-}
-
-/* Track max |y| and |psi| inside every accepted step (dense output at 4 interior points). */
-static int amp_observer(hm_dopri integ, double t_old, double t_new, const double *x_new, void *ctx) {
-  cyc *c = (cyc *)ctx;
-  for (int k = 1; k < 4; ++k) {
-    double yp[3];
-    if (hm_dopri_dense_partial(integ, t_old + (t_new - t_old) * k / 4.0, 0, 3, yp) == HM_OK) {
-      c->amp_y = fmax(c->amp_y, fabs(yp[0]));
-      c->amp_psi = fmax(c->amp_psi, fabs(yp[2]));
-    }
-  }
-  c->amp_y = fmax(c->amp_y, fabs(x_new[0]));
-  c->amp_psi = fmax(c->amp_psi, fabs(x_new[2]));
-  return 0;
-}
-
-static hm_status set_model(cyc *c, double p) {
-  hm_vehicle v = c->base;
-  double speed = c->base_speed_kmh;
-  hm_status st = hm_param_set(&v, &speed, c->param, p);
-  if (st != HM_OK) return st;
-  return hm_model_init(&c->model, &v, hm_mps_from_kmh(speed));
-}
-
-static hm_status shoot(cyc *c, const double *u, shot *s) {
-  const double T = u[3];
-  if (!(T > 0.0) || !isfinite(T)) return HM_EDOMAIN;
-  hm_status st = set_model(c, u[4]);
-  if (st != HM_OK) return st;
-  const double x0[NX] = {u[0], 0.0, u[1], u[2]};
-  double z[NZ];
-  memset(z, 0, sizeof z);
-  memcpy(z, x0, sizeof x0);
-  for (int i = 0; i < NX; ++i) z[NX + NX * i + i] = 1.0;
-  const double tau = c->symmetric ? 0.5 * T : T, sigma = c->symmetric ? -1.0 : 1.0;
-  c->amp_y = fabs(x0[0]);
-  c->amp_psi = fabs(x0[2]);
-  const hm_ode_system sys = {NZ, aug_rhs, NULL, c};
-  const hm_dopri_options dopt = {c->opt->rtol, c->opt->atol, 0.0, 0.0, 0};
-  st = hm_dopri_integrate(c->integ, &sys, &dopt, 0.0, tau, z, NULL, amp_observer, c, NULL);
-  if (st != HM_OK) return st;
-  double f[NX];
-  if ((st = hm_model_rhs(0.0, z, f, &c->model)) != HM_OK) return st;
-  memcpy(s->u, u, sizeof s->u);
-  static const int state_of_unknown[3] = {0, 2, 3};
-  for (int i = 0; i < NX; ++i) {
-    s->res[i] = z[i] - sigma * x0[i];
-    for (int k = 0; k < 3; ++k) {
-      const int j = state_of_unknown[k];
-      s->jac[NU * i + k] = z[NX + NX * j + i] - (i == j ? sigma : 0.0);
-    }
-    s->jac[NU * i + 3] = f[i] * (tau / T);
-    s->jac[NU * i + 4] = z[NX + NX * NX + i];
-  }
-  memcpy(s->phi, z + NX, sizeof s->phi);
-  s->amp_y = c->amp_y;
-  s->amp_psi = c->amp_psi;
-  return HM_OK;
-}
-
 /* The 5x5 Newton matrix [scaled Jacobian; row] in column-major order. */
-static void newton_matrix(const cyc *c, const shot *s, const double *row, double *A) {
+static void newton_matrix(const hm_sh *c, const hm_shot *s, const double *row, double *A) {
   for (int i = 0; i < NX; ++i)
-    for (int j = 0; j < NU; ++j) A[i + NU * j] = s->jac[NU * i + j] * c->sc[j] / RES_SCALE[i];
+    for (int j = 0; j < NU; ++j) A[i + NU * j] = s->jac[NW * i + j] * c->sc[j] / hm_sh_res_scale[i];
   for (int j = 0; j < NU; ++j) A[NX + NU * j] = row[j];
 }
 
@@ -172,17 +67,17 @@ static void newton_matrix(const cyc *c, const shot *s, const double *row, double
  * Converged when the scaled update is below newton_tol; *iters gets the iteration count; s receives the
  * last evaluation (at the iterate before the final, converged update).
  */
-static hm_status newton(cyc *c, double *u, const double *row, double target, shot *s, int *iters) {
-  double w[NU];
-  memcpy(w, u, sizeof w);
+static hm_status newton(hm_sh *c, double *u, const double *row, double target, hm_shot *s, int *iters) {
+  double w[NW] = {0, 0, 0, 0, 0, 0};
+  memcpy(w, u, NU * sizeof(double));
   for (size_t it = 0; it < c->opt->newton_max_iter; ++it) {
-    hm_status st = shoot(c, w, s);
+    hm_status st = hm_sh_shoot(c, w, s);
     if (st != HM_OK) return st;
     double A[NU * NU], b[NU];
     newton_matrix(c, s, row, A);
     double rowdot = 0.0;
     for (int j = 0; j < NU; ++j) rowdot += row[j] * w[j] / c->sc[j];
-    for (int i = 0; i < NX; ++i) b[i] = -s->res[i] / RES_SCALE[i];
+    for (int i = 0; i < NX; ++i) b[i] = -s->res[i] / hm_sh_res_scale[i];
     b[NX] = -(rowdot - target);
     int ipiv[NU], info = 0;
     const int n = NU, one = 1;
@@ -195,7 +90,7 @@ static hm_status newton(cyc *c, double *u, const double *row, double target, sho
     }
     if (!isfinite(dmax) || dmax > 50.0) return HM_ENOCONV; /* diverging */
     if (dmax <= c->opt->newton_tol) {
-      memcpy(u, w, sizeof w);
+      memcpy(u, w, NU * sizeof(double));
       if (iters) *iters = (int)it + 1;
       return HM_OK;
     }
@@ -204,7 +99,7 @@ static hm_status newton(cyc *c, double *u, const double *row, double target, sho
 }
 
 /* Unit tangent (scaled) of the branch: the null vector of the scaled Jacobian, oriented along ref. */
-static hm_status tangent_of(const cyc *c, const shot *s, const double *ref, double *t) {
+static hm_status tangent_of(const hm_sh *c, const hm_shot *s, const double *ref, double *t) {
   double A[NU * NU], b[NU] = {0, 0, 0, 0, 1.0};
   newton_matrix(c, s, ref, A);
   int ipiv[NU], info = 0;
@@ -234,18 +129,9 @@ typedef struct {
   int ns_count;          /* complex non-trivial multipliers outside the unit circle */
 } node;
 
-static hm_status eig4(const double *colmajor, double *re, double *im) {
-  double a[NX * NX], work[128], dummy[1];
-  memcpy(a, colmajor, sizeof a);
-  const int n = NX, one = 1, lwork = 128;
-  int info = 0;
-  dgeev_("N", "N", &n, a, &n, re, im, dummy, &one, dummy, &one, work, &lwork, &info, 1, 1);
-  return info == 0 ? HM_OK : HM_ELAPACK;
-}
-
-static hm_status fill_node(const cyc *c, const shot *s, const double *u, const double *t, node *nd) {
+static hm_status fill_node(const hm_sh *c, const hm_shot *s, const double *u, const double *t, node *nd) {
   double re[NX], im[NX];
-  hm_status st = eig4(s->phi, re, im);
+  hm_status st = hm_sh_eig4(s->phi, re, im);
   if (st != HM_OK) return st;
   /* Symmetric cycles: R = -Phi(T/2) has eigenvalues mu = -eig(Phi), the multipliers are mu^2, and
    * det(R + I) = prod(mu + 1) changes sign where a real mu crosses -1 (symmetry-breaking branch point).
@@ -317,14 +203,14 @@ static hm_status fill_node(const cyc *c, const shot *s, const double *u, const d
 }
 
 /* Corrector from node a along its tangent at arclength sigma; fills nd. */
-static hm_status step_from(cyc *c, const node *a, double sigma, node *nd, int *iters) {
+static hm_status step_from(hm_sh *c, const node *a, double sigma, node *nd, int *iters) {
   double u[NU], row[NU], target = 0.0;
   for (int j = 0; j < NU; ++j) {
     u[j] = a->u[j] + sigma * a->t[j] * c->sc[j];
     row[j] = a->t[j];
     target += a->t[j] * u[j] / c->sc[j];
   }
-  shot s;
+  hm_shot s;
   hm_status st = newton(c, u, row, target, &s, iters);
   if (st != HM_OK) return st;
   double t[NU];
@@ -335,7 +221,7 @@ static hm_status step_from(cyc *c, const node *a, double sigma, node *nd, int *i
 /* ---- event location ---- */
 
 typedef struct {
-  cyc *c;
+  hm_sh *c;
   const node *a;
   hm_cycle_event_kind kind;
   node last;
@@ -365,7 +251,7 @@ static hm_status locate_fn(double sigma, double *value, void *ctx) {
   return HM_OK;
 }
 
-static hm_status locate(cyc *c, const node *a, const node *b, double ds, hm_cycle_event_kind kind, node *out) {
+static hm_status locate(hm_sh *c, const node *a, const node *b, double ds, hm_cycle_event_kind kind, node *out) {
   locate_ctx l = {c, a, kind, *b};
   double root;
   hm_status st = hm_brent_root(locate_fn, &l, 0.0, ds, test_value(a, kind), test_value(b, kind),
@@ -378,7 +264,7 @@ static hm_status locate(cyc *c, const node *a, const node *b, double ds, hm_cycl
 static int sign_change(double x, double y) { return (x > 0.0) != (y > 0.0); }
 
 /* Detect and locate the events between consecutive nodes a and b (b reached from a with step ds). */
-static void detect_events(cyc *c, const node *a, const node *b, double ds, size_t index, hm_cycle_event *events,
+static void detect_events(hm_sh *c, const node *a, const node *b, double ds, size_t index, hm_cycle_event *events,
                           size_t max_events, size_t *n_events) {
   int flags[4] = {0, 0, 0, 0};
   flags[HM_CYCLE_LPC] = sign_change(a->pub.dparam_ds, b->pub.dparam_ds);
@@ -408,7 +294,7 @@ static void detect_events(cyc *c, const node *a, const node *b, double ds, size_
 /* ---- start at the Hopf point ---- */
 
 /* The Hopf point's value of the continuation parameter. */
-static double hopf_param(const cyc *c, const hm_hopf_point *hopf) {
+static double hopf_param(const hm_sh *c, const hm_hopf_point *hopf) {
   switch (c->param) {
     case HM_PARAM_SPEED: return hopf->speed_kmh;
     case HM_PARAM_KX: return hopf->kx_mn_m;
@@ -419,7 +305,7 @@ static double hopf_param(const cyc *c, const hm_hopf_point *hopf) {
 }
 
 /* First guess of the cycle of max|y| = amp from the critical eigenvector and the normal form. */
-static hm_status start_guess(cyc *c, const hm_hopf_point *hopf, double amp, double *u) {
+static hm_status start_guess(hm_sh *c, const hm_hopf_point *hopf, double amp, double *u) {
   hm_vehicle v = c->base;
   double speed = c->base_speed_kmh;
   const double ph = hopf_param(c, hopf);
@@ -451,40 +337,17 @@ static hm_status start_guess(cyc *c, const hm_hopf_point *hopf, double amp, doub
   return HM_OK;
 }
 
-static void scales_for(cyc *c) {
-  c->sc[0] = 1e-3;
-  c->sc[1] = 1e-3;
-  c->sc[2] = 1e-1;
-  c->sc[3] = 1e-2;
-  c->sc[4] = c->param == HM_PARAM_SPEED ? 1.0 : c->param == HM_PARAM_CONICITY ? 1e-3 : 0.03;
-}
-
 static int options_valid(const hm_cycle_options *o) {
   return o->p_max > o->p_min && o->amp_max_m > 0.0 && o->amp_start_m > 0.0 && o->amp_start_m < o->amp_max_m &&
          o->ds_min > 0.0 && o->ds_init >= o->ds_min && o->ds_max >= o->ds_init && o->rtol > 0.0 &&
          o->atol >= 0.0 && o->newton_tol > 0.0 && o->newton_max_iter > 0 && o->locate_tol > 0.0;
 }
 
-static hm_status cyc_init(cyc *c, const hm_vehicle *veh, double speed_kmh, const hm_cycle_options *opt) {
-  memset(c, 0, sizeof *c);
-  hm_status st = hm_vehicle_validate(veh, NULL, 0);
-  if (st != HM_OK) return st;
-  if (!(speed_kmh > 0.0) || !isfinite(speed_kmh)) return HM_EDOMAIN;
-  c->base = *veh;
-  c->base_speed_kmh = speed_kmh;
-  c->param = opt->param;
-  c->opt = opt;
-  c->symmetric = opt->use_symmetry && hm_conicity_is_even(&veh->conicity, 1e-12);
-  scales_for(c);
-  c->integ = hm_dopri_create(NZ);
-  return c->integ ? HM_OK : HM_ENOMEM;
-}
-
 /* Solve at fixed amplitude u[0] = amp (the start of the branch). */
-static hm_status solve_fixed(cyc *c, double *u, int which, double value, const double *tref, node *nd) {
+static hm_status solve_fixed(hm_sh *c, double *u, int which, double value, const double *tref, node *nd) {
   double row[NU] = {0, 0, 0, 0, 0};
   row[which] = 1.0;
-  shot s;
+  hm_shot s;
   hm_status st = newton(c, u, row, value / c->sc[which], &s, NULL);
   if (st != HM_OK) return st;
   double t[NU];
@@ -495,8 +358,8 @@ static hm_status solve_fixed(cyc *c, double *u, int which, double value, const d
 hm_status hm_cycle_solve(const hm_vehicle *veh, double speed_kmh, const hm_cycle_options *opt, double p,
                          const double x0_guess[4], double period_guess_s, hm_cycle_point *cycle) {
   if (!veh || !opt || !x0_guess || !cycle || !options_valid(opt)) return HM_EINVAL;
-  cyc c;
-  hm_status st = cyc_init(&c, veh, speed_kmh, opt);
+  hm_sh c;
+  hm_status st = hm_sh_init(&c, veh, speed_kmh, opt, 0, HM_PARAM_SPEED);
   if (st == HM_OK) {
     double u[NU] = {x0_guess[0], x0_guess[2], x0_guess[3], period_guess_s, p};
     const double tref[NU] = {1, 0, 0, 0, 0};
@@ -504,11 +367,11 @@ hm_status hm_cycle_solve(const hm_vehicle *veh, double speed_kmh, const hm_cycle
     st = solve_fixed(&c, u, 4, p, tref, &nd);
     if (st == HM_OK) *cycle = nd.pub;
   }
-  hm_dopri_destroy(c.integ);
+  hm_sh_free(&c);
   return st;
 }
 
-static hm_status start_branch(cyc *c, const hm_hopf_point *hopf, node *n0, node *n1) {
+static hm_status start_branch(hm_sh *c, const hm_hopf_point *hopf, node *n0, node *n1) {
   double u[NU];
   const double amp = c->opt->amp_start_m;
   hm_status st = start_guess(c, hopf, amp, u);
@@ -531,14 +394,14 @@ hm_status hm_cycles_continue(const hm_vehicle *veh, double speed_kmh, const hm_h
   if (!veh || !hopf || !opt || !n_points || !n_events || (max_points && !points) || (max_events && !events) ||
       !options_valid(opt))
     return HM_EINVAL;
-  cyc c;
-  hm_status st = cyc_init(&c, veh, speed_kmh, opt);
+  hm_sh c;
+  hm_status st = hm_sh_init(&c, veh, speed_kmh, opt, 0, HM_PARAM_SPEED);
   const char *reason = "step limit reached";
   size_t np = 0, ne = 0;
   node prev, cur;
   if (st == HM_OK) st = start_branch(&c, hopf, &prev, &cur);
   if (st != HM_OK) {
-    hm_dopri_destroy(c.integ);
+    hm_sh_free(&c);
     return st;
   }
   if (np < max_points) points[np] = prev.pub;
@@ -577,7 +440,7 @@ hm_status hm_cycles_continue(const hm_vehicle *veh, double speed_kmh, const hm_h
     if (iters <= 2) ds = fmin(1.5 * ds, opt->ds_max);
     else if (iters >= 5) ds = fmax(0.7 * ds, opt->ds_min);
   }
-  hm_dopri_destroy(c.integ);
+  hm_sh_free(&c);
   *n_points = np < max_points ? np : max_points;
   *n_events = ne < max_events ? ne : max_events;
   if (stop_reason) *stop_reason = reason;

@@ -1,0 +1,132 @@
+/* Single shooting of the model's cycles with variational equations (see cycles.h). */
+#include "shooting.h"
+
+#include <math.h>
+#include <string.h>
+
+#include "hunting_monitor/linear.h"
+#include "lapack.h"
+
+const double hm_sh_res_scale[NX] = {1e-3, 1e-1, 1e-3, 1e-1};
+
+double hm_sh_param_scale(hm_param p) {
+  return p == HM_PARAM_SPEED ? 1.0 : p == HM_PARAM_CONICITY ? 1e-3 : 0.03;
+}
+
+hm_status hm_sh_init(hm_sh *c, const hm_vehicle *veh, double speed_kmh, const hm_cycle_options *opt,
+                     int has_param2, hm_param param2) {
+  memset(c, 0, sizeof *c);
+  hm_status st = hm_vehicle_validate(veh, NULL, 0);
+  if (st != HM_OK) return st;
+  if (!(speed_kmh > 0.0) || !isfinite(speed_kmh)) return HM_EDOMAIN;
+  c->base = *veh;
+  c->base_speed_kmh = speed_kmh;
+  c->param = opt->param;
+  c->param2 = param2;
+  c->has_param2 = has_param2;
+  c->opt = opt;
+  c->symmetric = opt->use_symmetry && hm_conicity_is_even(&veh->conicity, 1e-12);
+  const double sc[NW] = {1e-3, 1e-3, 1e-1, 1e-2, hm_sh_param_scale(opt->param), hm_sh_param_scale(param2)};
+  memcpy(c->sc, sc, sizeof sc);
+  c->integ = hm_dopri_create(NZ);
+  return c->integ ? HM_OK : HM_ENOMEM;
+}
+
+void hm_sh_free(hm_sh *c) {
+  hm_dopri_destroy(c->integ);
+  c->integ = NULL;
+}
+
+/* x' = f, Phi' = J Phi, s1' = J s1 + df/dp1, s2' = J s2 + df/dp2. */
+static hm_status aug_rhs(double t, const double *z, double *dz, void *ctx) {
+  hm_sh *c = (hm_sh *)ctx;
+  double J[NX * NX], dfdp[2][NX];
+  hm_status st = hm_model_rhs(t, z, dz, &c->model);
+  if (st != HM_OK) return st;
+  hm_model_jacobian(t, z, J, &c->model);
+  hm_model_dparam(&c->model, c->param, z, dfdp[0]);
+  const int ncols = NX + 1 + c->has_param2;
+  if (c->has_param2) hm_model_dparam(&c->model, c->param2, z, dfdp[1]);
+  for (int col = 0; col < ncols; ++col) {
+    const double *v = z + NX + NX * col;
+    double *dv = dz + NX + NX * col;
+    const double *forcing = col >= NX ? dfdp[col - NX] : NULL;
+    for (int i = 0; i < NX; ++i) {
+      const double *Ji = J + NX * i;
+      dv[i] = Ji[0] * v[0] + Ji[1] * v[1] + Ji[2] * v[2] + Ji[3] * v[3] + (forcing ? forcing[i] : 0.0);
+    }
+  }
+  return HM_OK;
+}
+
+/* Track max |y| and |psi| inside every accepted step (dense output at 4 interior points). */
+static int amp_observer(hm_dopri integ, double t_old, double t_new, const double *x_new, void *ctx) {
+  hm_sh *c = (hm_sh *)ctx;
+  for (int k = 1; k < 4; ++k) {
+    double yp[3];
+    if (hm_dopri_dense_partial(integ, t_old + (t_new - t_old) * k / 4.0, 0, 3, yp) == HM_OK) {
+      c->amp_y = fmax(c->amp_y, fabs(yp[0]));
+      c->amp_psi = fmax(c->amp_psi, fabs(yp[2]));
+    }
+  }
+  c->amp_y = fmax(c->amp_y, fabs(x_new[0]));
+  c->amp_psi = fmax(c->amp_psi, fabs(x_new[2]));
+  return 0;
+}
+
+static hm_status set_model(hm_sh *c, double p1, double p2) {
+  hm_vehicle v = c->base;
+  double speed = c->base_speed_kmh;
+  hm_status st = hm_param_set(&v, &speed, c->param, p1);
+  if (st == HM_OK && c->has_param2) st = hm_param_set(&v, &speed, c->param2, p2);
+  if (st != HM_OK) return st;
+  return hm_model_init(&c->model, &v, hm_mps_from_kmh(speed));
+}
+
+hm_status hm_sh_shoot(hm_sh *c, const double *u, hm_shot *s) {
+  const double T = u[3];
+  if (!(T > 0.0) || !isfinite(T)) return HM_EDOMAIN;
+  hm_status st = set_model(c, u[4], c->has_param2 ? u[5] : 0.0);
+  if (st != HM_OK) return st;
+  const double x0[NX] = {u[0], 0.0, u[1], u[2]};
+  double z[NZ];
+  memset(z, 0, sizeof z);
+  memcpy(z, x0, sizeof x0);
+  for (int i = 0; i < NX; ++i) z[NX + NX * i + i] = 1.0;
+  const double tau = c->symmetric ? 0.5 * T : T, sigma = c->symmetric ? -1.0 : 1.0;
+  c->amp_y = fabs(x0[0]);
+  c->amp_psi = fabs(x0[2]);
+  const hm_ode_system sys = {NZ, aug_rhs, NULL, c};
+  const hm_dopri_options dopt = {c->opt->rtol, c->opt->atol, 0.0, 0.0, 0};
+  st = hm_dopri_integrate(c->integ, &sys, &dopt, 0.0, tau, z, NULL, amp_observer, c, NULL);
+  if (st != HM_OK) return st;
+  double f[NX];
+  if ((st = hm_model_rhs(0.0, z, f, &c->model)) != HM_OK) return st;
+  memcpy(s->u, u, NU * sizeof(double));
+  s->u[5] = c->has_param2 ? u[5] : 0.0;
+  static const int state_of_unknown[3] = {0, 2, 3};
+  for (int i = 0; i < NX; ++i) {
+    s->res[i] = z[i] - sigma * x0[i];
+    for (int k = 0; k < 3; ++k) {
+      const int j = state_of_unknown[k];
+      s->jac[NW * i + k] = z[NX + NX * j + i] - (i == j ? sigma : 0.0);
+    }
+    s->jac[NW * i + 3] = f[i] * (tau / T);
+    s->jac[NW * i + 4] = z[NX + NX * NX + i];
+    s->jac[NW * i + 5] = c->has_param2 ? z[NX + NX * NX + NX + i] : 0.0;
+  }
+  memcpy(s->phi, z + NX, sizeof s->phi);
+  s->amp_y = c->amp_y;
+  s->amp_psi = c->amp_psi;
+  return HM_OK;
+}
+
+hm_status hm_sh_eig4(const double *colmajor, double *re, double *im) {
+  double a[NX * NX], work[128], dummy[1];
+  memcpy(a, colmajor, sizeof a);
+  const int n = NX, one = 1, lwork = 128;
+  int info = 0;
+  dgeev_("N", "N", &n, a, &n, re, im, dummy, &one, dummy, &one, work, &lwork, &info, 1, 1);
+  return info == 0 ? HM_OK : HM_ELAPACK;
+}
+
