@@ -164,3 +164,71 @@ void json_eigenvalues(FILE *f, const double re[4], const double im[4]) {
   }
   fputc(']', f);
 }
+
+/* ---- JSON writer ---- */
+
+void jw_init(json_writer *w, FILE *f) {
+  memset(w, 0, sizeof *w);
+  w->f = f;
+}
+
+static void jw_prefix(json_writer *w, const char *key) {
+  if (w->count[w->depth]++ > 0) fputs(", ", w->f);
+  if (key) fprintf(w->f, "\"%s\": ", key);
+}
+
+void jw_object(json_writer *w, const char *key) {
+  jw_prefix(w, key);
+  fputc('{', w->f);
+  if (w->depth < 31) w->count[++w->depth] = 0;
+}
+
+void jw_array(json_writer *w, const char *key) {
+  jw_prefix(w, key);
+  fputc('[', w->f);
+  if (w->depth < 31) w->count[++w->depth] = 0;
+}
+
+void jw_end_object(json_writer *w) {
+  fputc('}', w->f);
+  if (w->depth > 0) --w->depth;
+}
+
+void jw_end_array(json_writer *w) {
+  fputc(']', w->f);
+  if (w->depth > 0) --w->depth;
+}
+
+void jw_number(json_writer *w, const char *key, double value) {
+  jw_prefix(w, key);
+  if (isfinite(value))
+    fprintf(w->f, "%.12g", value);
+  else
+    fputs("null", w->f);
+}
+
+void jw_int(json_writer *w, const char *key, long value) {
+  jw_prefix(w, key);
+  fprintf(w->f, "%ld", value);
+}
+
+void jw_string(json_writer *w, const char *key, const char *value) {
+  jw_prefix(w, key);
+  fputc('"', w->f);
+  for (const char *c = value; *c; ++c) {
+    if (*c == '"' || *c == '\\')
+      fprintf(w->f, "\\%c", *c);
+    else if ((unsigned char)*c < 0x20)
+      fprintf(w->f, "\\u%04x", (unsigned)(unsigned char)*c);
+    else
+      fputc(*c, w->f);
+  }
+  fputc('"', w->f);
+}
+
+void jw_bool(json_writer *w, const char *key, int value) {
+  jw_prefix(w, key);
+  fputs(value ? "true" : "false", w->f);
+}
+
+void jw_finish(json_writer *w) { fputc('\n', w->f); }

@@ -44,4 +44,40 @@ void cli_print_help(FILE *f, const char *command, const char *usage, const char 
 void json_number(FILE *f, double x);
 void json_eigenvalues(FILE *f, const double re[4], const double im[4]);
 
+/* A small streaming JSON writer: keys are NULL inside arrays. Numbers with 12 significant digits; a
+ * non-finite number is written as null (JSON has no NaN). */
+typedef struct {
+  FILE *f;
+  int depth;
+  int count[32]; /* items written at each depth */
+} json_writer;
+
+void jw_init(json_writer *w, FILE *f);
+void jw_object(json_writer *w, const char *key);
+void jw_array(json_writer *w, const char *key);
+void jw_end_object(json_writer *w);
+void jw_end_array(json_writer *w);
+void jw_number(json_writer *w, const char *key, double value);
+void jw_int(json_writer *w, const char *key, long value);
+void jw_string(json_writer *w, const char *key, const char *value);
+void jw_bool(json_writer *w, const char *key, int value);
+/* Ends the document with a newline. */
+void jw_finish(json_writer *w);
+
+/* Commands implemented in cmd_bifurcation.c */
+extern const cli_option hopf_opts[], cycles_opts[], hopf_curve_opts[], lpc_curve_opts[];
+int cmd_hopf(const cli_args *a);
+int cmd_cycles(const cli_args *a);
+int cmd_hopf_curve(const cli_args *a);
+int cmd_lpc_curve(const cli_args *a);
+int cli_fail_status(const char *what, hm_status st);
+int cli_speed_option(const cli_args *a, double *v_kmh);
+
+#define CLI_VEHICLE_OPTIONS                                                                                  \
+  {"config", "FILE", "vehicle config YAML (default: built-in CRH380 defaults = config/crh380_default.yaml)"}, \
+      {"kx", "MN/m", "primary longitudinal stiffness Kx (overrides the config)"},                            \
+      {"ky", "MN/m", "primary lateral stiffness Ky (overrides the config)"},                                 \
+      {"conicity", "L", "equivalent conicity at y = 0 (shifts the constant term of lambda(y))"},            \
+      {"help", NULL, "show this help"}
+
 #endif

@@ -11,20 +11,16 @@
 #include "hunting_monitor/lyapunov.h"
 #include "hunting_monitor/model.h"
 
-#define VEHICLE_OPTIONS                                                                                      \
-  {"config", "FILE", "vehicle config YAML (default: built-in CRH380 defaults = config/crh380_default.yaml)"}, \
-      {"kx", "MN/m", "primary longitudinal stiffness Kx (overrides the config)"},                            \
-      {"ky", "MN/m", "primary lateral stiffness Ky (overrides the config)"},                                 \
-      {"conicity", "L", "equivalent conicity at y = 0 (shifts the constant term of lambda(y))"},            \
-      {"help", NULL, "show this help"}
+#define VEHICLE_OPTIONS CLI_VEHICLE_OPTIONS
 
-static int fail_status(const char *what, hm_status st) {
+int cli_fail_status(const char *what, hm_status st) {
   fprintf(stderr, "hunting: %s: %s\n", what, hm_status_str(st));
   return 1;
 }
+#define fail_status cli_fail_status
 
 /* Speed option --v in km/h, required, > 0. */
-static int speed_option(const cli_args *a, double *v_kmh) {
+int cli_speed_option(const cli_args *a, double *v_kmh) {
   if (!cli_has(a, "v")) {
     fprintf(stderr, "hunting: --v KM/H (running speed) is required\n");
     return 1;
@@ -85,7 +81,7 @@ static const cli_option critical_conicity_opts[] = {
 static int cmd_critical_conicity(const cli_args *a) {
   hm_vehicle veh;
   double v_kmh, lambda_c;
-  if (cli_vehicle(a, &veh, NULL) || speed_option(a, &v_kmh)) return 1;
+  if (cli_vehicle(a, &veh, NULL) || cli_speed_option(a, &v_kmh)) return 1;
   hm_status st = hm_linear_critical_conicity(&veh, hm_mps_from_kmh(v_kmh), &lambda_c);
   if (st == HM_ENOCRIT) {
     fprintf(stderr, "hunting: no critical conicity: the linear model is unstable at %g km/h for every conicity\n",
@@ -108,7 +104,7 @@ static const cli_option eig_opts[] = {{"v", "KM/H", "running speed (required)"},
 static int cmd_eig(const cli_args *a) {
   hm_vehicle veh;
   double v_kmh, re[4], im[4];
-  if (cli_vehicle(a, &veh, NULL) || speed_option(a, &v_kmh)) return 1;
+  if (cli_vehicle(a, &veh, NULL) || cli_speed_option(a, &v_kmh)) return 1;
   const double lambda = cli_conicity0(&veh);
   hm_status st = hm_linear_eigenvalues(&veh, lambda, hm_mps_from_kmh(v_kmh), re, im);
   if (st != HM_OK) return fail_status("eigenvalues", st);
@@ -173,7 +169,7 @@ static int sim_observer(hm_dopri integ, double t_old, double t_new, const double
 static int cmd_simulate(const cli_args *a) {
   hm_vehicle veh, lin;
   double v_kmh, x[4] = {0.001, 0.0, 0.0, 0.0}, t_end = 10.0, dt_out = 0.001, rtol = 1e-9, atol = 1e-12;
-  if (cli_vehicle(a, &veh, NULL) || speed_option(a, &v_kmh) || cli_number_list(a, "x0", x, 4) ||
+  if (cli_vehicle(a, &veh, NULL) || cli_speed_option(a, &v_kmh) || cli_number_list(a, "x0", x, 4) ||
       cli_number(a, "t", &t_end) || cli_number(a, "dt-out", &dt_out) || cli_number(a, "rtol", &rtol) ||
       cli_number(a, "atol", &atol))
     return 1;
@@ -230,7 +226,7 @@ static int cmd_lyapunov(const cli_args *a) {
   hm_lyap_options opt;
   hm_lyap_options_default(&opt);
   double v_kmh, x[4] = {0.0, 0.0, 0.0, 0.0};
-  if (cli_vehicle(a, &veh, NULL) || speed_option(a, &v_kmh) || cli_number_list(a, "x0", x, 4) ||
+  if (cli_vehicle(a, &veh, NULL) || cli_speed_option(a, &v_kmh) || cli_number_list(a, "x0", x, 4) ||
       cli_number(a, "t", &opt.duration_s) || cli_number(a, "transient", &opt.transient_s) ||
       cli_number(a, "h", &opt.step_s) || cli_number(a, "renorm", &opt.renorm_interval_s) ||
       cli_number(a, "rtol", &opt.rtol) || cli_number(a, "atol", &opt.atol))
@@ -369,6 +365,22 @@ static const command commands[] = {
      "Lyapunov exponent spectrum [1/s] of a trajectory (Benettin with QR re-orthonormalisation), by the\n"
      "implicit midpoint rule (the study's method) or Dormand-Prince on the variational equations.",
      lyapunov_opts, cmd_lyapunov},
+    {"hopf", "Hopf point of the nonlinear model and its Lyapunov coefficients", "[--param v|kx|ky|conicity] [options]",
+     "Hopf point of the origin along a parameter with the first Lyapunov coefficient l1 (MATCONT convention; > 0\n"
+     "subcritical) and the second l2 (meaningful where l1 = 0). For --param kx, ky or conicity give --v and a range.",
+     hopf_opts, cmd_hopf},
+    {"cycles", "family of limit cycles from the Hopf point, folds, stability", "[--param v] [options]",
+     "Continue the limit cycles born at the Hopf point (shooting with Floquet multipliers, pseudo-arclength):\n"
+     "folds (LPC) with the side of the stable cycles, symmetry-breaking branch points (BPC), period doublings, NS\n"
+     "points, the lowest speed with a cycle, and the branch (parameter, amplitude, period, stability).",
+     cycles_opts, cmd_cycles},
+    {"hopf-curve", "two-parameter Hopf curve with GH points", "--plane kx-v|ky-v|kx-ky --from A --to B [options]",
+     "Hopf curve in a parameter plane with l1 along it and the generalised Hopf points (l1 = 0) with l2.",
+     hopf_curve_opts, cmd_hopf_curve},
+    {"lpc-curve", "two-parameter curve of folds of cycles with cusps", "--plane kx-v|ky-v --from A --to B [options]",
+     "Fold-of-cycles (LPC) curves in the (stiffness, speed) plane, continued from the folds found at --start,\n"
+     "with their cusp points (CPC).",
+     lpc_curve_opts, cmd_lpc_curve},
     {"sweep", "linear critical speed over a conicity range", "[--from L --to L --n COUNT] [--table]",
      "Linear critical speed over a range of equivalent conicities (JSON, or a table with --table).", sweep_opts,
      cmd_sweep},

@@ -210,9 +210,16 @@ static hm_status step_from(hm_sh *c, const node *a, double sigma, node *nd, int 
     row[j] = a->t[j];
     target += a->t[j] * u[j] / c->sc[j];
   }
+  double pred[NU];
+  memcpy(pred, u, sizeof pred);
   hm_shot s;
   hm_status st = newton(c, u, row, target, &s, iters);
   if (st != HM_OK) return st;
+  /* A corrector that lands farther from the predictor than the step itself has jumped to another branch
+   * (typically the trivial one, x0 = 0, which solves the shooting equations for every T and p). */
+  double dist = 0.0;
+  for (int j = 0; j < NU; ++j) dist += (u[j] - pred[j]) * (u[j] - pred[j]) / (c->sc[j] * c->sc[j]);
+  if (sqrt(dist) > fmax(fabs(sigma), 0.05)) return HM_ENOCONV;
   double t[NU];
   if ((st = tangent_of(c, &s, a->t, t)) != HM_OK) return st;
   return fill_node(c, &s, u, t, nd);

@@ -134,7 +134,15 @@ static hm_status lpc_step(lctx *l, const lnode *a, double sigma, lnode *out, int
     w[j] = a->w[j] + sigma * a->t[j] * l->sh.sc[j];
     target += a->t[j] * w[j] / l->sh.sc[j];
   }
-  return lpc_correct(l, w, a->t, target, a->t, out, iters);
+  hm_status st = lpc_correct(l, w, a->t, target, a->t, out, iters);
+  if (st != HM_OK) return st;
+  /* reject a corrector that left the neighbourhood of the predictor (a jump to another branch) */
+  double dist = 0.0;
+  for (int j = 0; j < NW; ++j) {
+    const double d = (out->w[j] - a->w[j]) / l->sh.sc[j] - sigma * a->t[j];
+    dist += d * d;
+  }
+  return sqrt(dist) > fmax(fabs(sigma), 0.05) ? HM_ENOCONV : HM_OK;
 }
 
 static hm_lpc_point to_point(const lnode *n) {

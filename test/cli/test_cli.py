@@ -145,7 +145,8 @@ def test_bad_input_gives_clear_errors():
 def test_help_is_available():
     p = run("--help")
     assert "critical" in p.stdout and "simulate" in p.stdout
-    for cmd in ["critical", "critical-conicity", "eig", "simulate", "lyapunov", "sweep"]:
+    for cmd in ["critical", "critical-conicity", "eig", "simulate", "lyapunov", "sweep", "hopf", "cycles",
+                "hopf-curve", "lpc-curve"]:
         p = run(cmd, "--help")
         assert p.stdout.startswith(f"usage: hunting {cmd}"), p.stdout
     assert run(ok=False).returncode == 2
@@ -159,6 +160,97 @@ def test_sweep_matches_critical():
     # Critical speed falls with conicity (Klingel: frequency ~ v sqrt(lambda)).
     speeds = [r["v_crit_kmh"] for r in out["rows"]]
     assert speeds[0] > speeds[1] > speeds[2], speeds
+
+
+def test_hopf_published_values():
+    # MODEL.md section 6, Ky = 10.96: Hopf V to 1e-3 km/h, l1 to 4 significant digits
+    for kx, v_ref, l1_ref in [(9.1, 527.4349, 7.4072), (9.7, 544.3795, 3.8482), (9.9, 550.3513, 2.7316)]:
+        out = run_json("hopf", "--param", "v", "--kx", str(kx), "--ky", "10.96")
+        close(out["v_kmh"], v_ref, 1e-3, f"Hopf v_kmh kx={kx}")
+        close(out["l1"], l1_ref, 1e-4 * abs(l1_ref), f"l1 kx={kx}")
+        assert out["kind"] == "subcritical", out
+    out = run_json("hopf", "--param", "kx", "--v", "566.5220", "--ky", "10.96", "--from", "5", "--to", "15")
+    assert len(out["points"]) == 1, out
+    close(out["points"][0]["kx_mn_m"], 10.413634, 2e-5, "Hopf Kx at 566.522 km/h")
+
+
+def test_hopf_curve_gh_point():
+    out = run_json("hopf-curve", "--plane", "kx-v", "--ky", "10.96", "--from", "9.0", "--to", "10.7")
+    assert len(out["gh"]) == 1, out["gh"]
+    gh = out["gh"][0]
+    close(gh["kx_mn_m"], 10.413634, 1e-5, "GH kx")
+    close(gh["v_kmh"], 566.5220, 1e-3, "GH v")
+    close(gh["l2"], -37.5146, 1e-4 * 37.5146, "GH l2")
+    # l1 changes sign along the curve exactly once, at the GH point
+    signs = [p["l1"] > 0 for p in out["points"]]
+    assert signs[0] and not signs[-1] and sum(a != b for a, b in zip(signs, signs[1:])) == 1, signs
+
+
+def test_cycles_published_folds():
+    for kx, refs, amps in [(9.7, (542.478651, 543.209002), (4.17e-3, 5.98e-3)),
+                           (9.9, (549.363387, 551.158654), (3.43e-3, 6.08e-3))]:
+        out = run_json("cycles", "--kx", str(kx), "--ky", "10.96", "--amp-max", "0.0075")
+        folds = out["folds"]
+        assert len(folds) == 2, folds
+        for f, ref, amp in zip(folds, refs, amps):
+            close(f["v_kmh"], ref, 0.01, f"LPC kx={kx}")
+            close(f["amplitude_m"], amp, 1e-5, f"LPC amplitude kx={kx}")
+        assert [f["stable_side"] for f in folds] == ["upper", "lower"], folds
+        # the branch between the folds is stable, outside it unstable (Floquet multipliers)
+        for p in out["branch"]:
+            inside = folds[0]["amplitude_m"] + 1e-5 < p["amplitude_m"] < folds[1]["amplitude_m"] - 1e-5
+            outside = p["amplitude_m"] < folds[0]["amplitude_m"] - 1e-5 or p["amplitude_m"] > folds[1]["amplitude_m"] + 1e-5
+            assert (inside and p["stable"]) or (outside and not p["stable"]) or not (inside or outside), p
+
+
+def test_cycles_csv_and_refinement():
+    with tempfile.TemporaryDirectory() as d:
+        path = os.path.join(d, "branch.csv")
+        run("cycles", "--kx", "9.7", "--ky", "10.96", "--amp-max", "0.007", "--csv", "--out", path)
+        with open(path) as f:
+            rows = list(csv.DictReader(f))
+    assert list(rows[0].keys())[:3] == ["v_kmh", "amplitude_m", "amplitude_psi_rad"], rows[0].keys()
+    assert len(rows) > 20
+    out = run_json("cycles", "--kx", "9.7", "--ky", "10.96", "--amp-max", "0.007", "--refine")
+    assert all(r["persists"] and abs(r["change"]) < 1e-4 for r in out["refinement"]), out["refinement"]
+
+
+def test_lpc_curve_cusp():
+    out = run_json("lpc-curve", "--plane", "kx-v", "--ky", "10.96", "--from", "9.0", "--to", "10.7",
+                   "--amp-max", "0.0075")
+    assert len(out["cusps"]) == 1, out["cusps"]
+    c = out["cusps"][0]
+    close(c["kx_mn_m"], 9.416863, 1e-5, "CPC kx")
+    close(c["v_kmh"], 532.4952, 1e-3, "CPC v")
+    close(c["amplitude_m"], 5.47e-3, 1e-5, "CPC amplitude")
+    # the curve passes through the one-parameter folds at Kx = 9.7 (542.478651 and 543.209002 km/h)
+    pts = out["curves"][0]["points"]
+    crossings = []
+    for a, b in zip(pts, pts[1:]):
+        if (a["kx_mn_m"] - 9.7) * (b["kx_mn_m"] - 9.7) <= 0 and a["kx_mn_m"] != b["kx_mn_m"]:
+            t = (9.7 - a["kx_mn_m"]) / (b["kx_mn_m"] - a["kx_mn_m"])
+            crossings.append(a["v_kmh"] + t * (b["v_kmh"] - a["v_kmh"]))
+    crossings.sort()
+    assert len(crossings) == 2, crossings
+    close(crossings[0], 542.478651, 0.01, "LPC curve at Kx 9.7 (lower)")
+    close(crossings[1], 543.209002, 0.01, "LPC curve at Kx 9.7 (upper)")
+
+
+def test_bifurcation_bad_input():
+    cases = [
+        (["hopf", "--param", "mass"], "--param must be v, kx, ky or conicity"),
+        (["hopf", "--param", "kx"], "--v KM/H (running speed) is required"),
+        (["hopf", "--v", "500"], "--v is the parameter here"),
+        (["hopf", "--v-min", "100"], "unknown option '--v-min'"),
+        (["cycles", "--amp-max", "-1"], "need --v-min < --v-max, --amp-max >"),
+        (["cycles", "--v-min", "600", "--v-max", "700"], "no Hopf point of the origin"),
+        (["hopf-curve", "--plane", "xy"], "--plane must be kx-v, ky-v or kx-ky"),
+        (["lpc-curve", "--from", "10", "--to", "9"], "need --from < --to"),
+    ]
+    for args, message in cases:
+        p = run(*args, ok=False)
+        assert p.returncode != 0, f"{args} exited 0"
+        assert message in p.stderr, f"{args}: stderr {p.stderr!r} lacks {message!r}"
 
 
 def main():
