@@ -70,6 +70,9 @@ int cmd_hopf(const cli_args *a);
 int cmd_cycles(const cli_args *a);
 int cmd_hopf_curve(const cli_args *a);
 int cmd_lpc_curve(const cli_args *a);
+extern const cli_option tables_opts[], table_lookup_opts[];
+int cmd_tables(const cli_args *a);
+int cmd_table_lookup(const cli_args *a);
 int cli_fail_status(const char *what, hm_status st);
 int cli_speed_option(const cli_args *a, double *v_kmh);
 

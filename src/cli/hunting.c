@@ -381,6 +381,14 @@ static const command commands[] = {
      "Fold-of-cycles (LPC) curves in the (stiffness, speed) plane, continued from the folds found at --start,\n"
      "with their cusp points (CPC).",
      lpc_curve_opts, cmd_lpc_curve},
+    {"tables", "boundary tables for the online monitor", "--out FILE [options]",
+     "Compute the monitor's boundary tables over a conicity grid (Hopf speed, lowest speed with a cycle, the\n"
+     "cycle families) with their measured interpolation error, and write them to FILE.",
+     tables_opts, cmd_tables},
+    {"table-lookup", "query a boundary table", "--table FILE --conicity L --v KM/H",
+     "Boundaries at one conicity and speed from a table: Hopf and lowest cycle speeds, the unstable cycle (edge\n"
+     "of the basin of the stable origin) and the stable cycle beyond it; null where none exists.",
+     table_lookup_opts, cmd_table_lookup},
     {"sweep", "linear critical speed over a conicity range", "[--from L --to L --n COUNT] [--table]",
      "Linear critical speed over a range of equivalent conicities (JSON, or a table with --table).", sweep_opts,
      cmd_sweep},

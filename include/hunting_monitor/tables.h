@@ -1,0 +1,90 @@
+/*
+ * hunting_monitor - boundary tables: what the online monitor consults.
+ *
+ * For a vehicle and a grid of equivalent conicities lambda(0) (the constant term of lambda(y) shifted), the
+ * table holds the Hopf speed and l1, the lowest speed at which any limit cycle exists (the nonlinear critical
+ * speed: the minimum of the speed over the whole cycle family, i.e. over its folds) and the family of cycles
+ * itself as a polyline (speed, amplitude max|y|, stability), decimated so that linear interpolation along it
+ * stays within 1 um and 0.01 km/h of the computed branch.
+ *
+ * A lookup at (conicity, speed) interpolates 1/V_hopf^2 linearly in conicity (exact: the Hurwitz condition is
+ * affine in lambda), and compares the two neighbouring conicities' cycle families at the same fraction of their
+ * own Hopf speed (hunting speeds scale together, Klingel's V ~ 1/sqrt(lambda)): each family is intersected
+ * with that speed, giving the edge of the basin of the stable origin (the smallest unstable cycle; zero where
+ * the origin is unstable, none where no cycle exists) and the smallest stable cycle beyond it; amplitudes and
+ * speed ratios are then interpolated linearly in conicity. The table
+ * states its own interpolation error: at build time every midpoint conicity is computed as well and compared
+ * with the lookup (Hopf and lowest-cycle speeds, and edge amplitudes at every 5 km/h).
+ *
+ * File format (text, one record per line, '#' comments):
+ *   hunting_monitor_boundary_table 1
+ *   kx_mn_m K  ky_mn_m K  speed_min_kmh V  speed_max_kmh V  amp_max_m A
+ *   error_hopf_kmh E  error_lowest_kmh E  error_edge_amp_m E
+ *   conicity L hopf_kmh V l1 X lowest_kmh V n N      (then N lines: v_kmh amplitude_m stable)
+ */
+#ifndef HUNTING_MONITOR_TABLES_H
+#define HUNTING_MONITOR_TABLES_H
+
+#include <stddef.h>
+
+#include "hunting_monitor/model.h"
+#include "hunting_monitor/status.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+typedef struct hm_table_s *hm_table;
+
+typedef struct {
+  double conicity_min, conicity_max;  /* lambda(0) range */
+  size_t n_conicity;                  /* grid points, >= 2 */
+  double speed_min_kmh, speed_max_kmh;/* continuation range of the cycle families */
+  double amp_max_m;                   /* largest cycle amplitude followed */
+  double rtol;                        /* shooting tolerance */
+} hm_table_spec;
+
+/* Defaults: conicity 0.05..0.40 (15 points), speeds 150..700 km/h, cycles up to 16 mm, rtol 1e-10. */
+void hm_table_spec_default(hm_table_spec *spec);
+
+/* Compute a table (about 2 continuations per grid point; seconds). */
+hm_status hm_table_build(const hm_vehicle *veh, const hm_table_spec *spec, hm_table *out);
+
+/* Serialise into buf (len bytes); *needed gets the full size including the terminating NUL. HM_EINVAL if
+ * len is too small (then call again with *needed bytes). */
+hm_status hm_table_format(const hm_table t, char *buf, size_t len, size_t *needed);
+
+/* Parse text (HM_EPARSE with "line N: reason" in err); hm_table_load_file reads a file first (HM_EIO). */
+hm_status hm_table_parse(const char *text, size_t len, hm_table *out, char *err, size_t err_len);
+hm_status hm_table_load_file(const char *path, hm_table *out, char *err, size_t err_len);
+
+void hm_table_destroy(hm_table t);
+
+typedef struct {
+  double conicity;              /* the query's conicity, clamped to the table */
+  double hopf_speed_kmh;        /* linear critical speed */
+  double l1;                    /* first Lyapunov coefficient there */
+  double lowest_cycle_speed_kmh;/* nonlinear critical speed: below it no cycle exists */
+  int origin_stable;            /* speed below the Hopf speed */
+  int has_edge;                 /* an unstable cycle bounds the basin of the stable origin at this speed */
+  double edge_amp_m;            /* its amplitude max|y| (0 if the origin is unstable) */
+  int has_stable_outer;         /* a stable cycle exists beyond the edge (hunting stays bounded there) */
+  double stable_outer_amp_m;    /* its amplitude */
+  int clamped;                  /* the conicity or speed was outside the table and was clamped */
+  int consistent;               /* both neighbouring conicities have the same cycles (count, edge, outer) here */
+  double neighbour_spread_m;    /* largest difference of the neighbours' amplitudes (a local error indicator) */
+  double error_speed_kmh;       /* stated interpolation error of the speeds (max of the table's two) */
+  double error_amp_m;           /* stated interpolation error of the amplitudes where consistent */
+} hm_table_lookup_result;
+
+/* Boundaries at (conicity, speed). No allocation. HM_EDOMAIN for non-finite input. */
+hm_status hm_table_lookup(const hm_table t, double conicity, double speed_kmh, hm_table_lookup_result *out);
+
+/* Number of conicities and the range, for reporting. */
+size_t hm_table_size(const hm_table t, double *conicity_min, double *conicity_max);
+
+#ifdef __cplusplus
+}
+#endif
+
+#endif

@@ -1,0 +1,508 @@
+/* Boundary tables: build from cycle families, serialise, parse, and look up (see tables.h). */
+#include "hunting_monitor/tables.h"
+
+#include <errno.h>
+#include <math.h>
+#include <stdarg.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "hunting_monitor/cycles.h"
+#include "hunting_monitor/hopf.h"
+
+typedef struct {
+  double v_kmh, amp_m;
+  int stable;
+} tpoint;
+
+typedef struct {
+  double conicity, hopf_kmh, l1, lowest_kmh;
+  size_t n;
+  tpoint *pts;
+} tcurve;
+
+struct hm_table_s {
+  double kx_mn_m, ky_mn_m, speed_min_kmh, speed_max_kmh, amp_max_m;
+  double err_hopf_kmh, err_lowest_kmh, err_amp_m;
+  size_t n;
+  tcurve *curves;
+};
+
+void hm_table_spec_default(hm_table_spec *spec) {
+  spec->conicity_min = 0.05;
+  spec->conicity_max = 0.40;
+  spec->n_conicity = 15;
+  spec->speed_min_kmh = 150.0;
+  spec->speed_max_kmh = 700.0;
+  spec->amp_max_m = 0.016;
+  spec->rtol = 1e-10;
+}
+
+void hm_table_destroy(hm_table t) {
+  if (!t) return;
+  for (size_t i = 0; i < t->n; ++i) free(t->curves[i].pts);
+  free(t->curves);
+  free(t);
+}
+
+static hm_table table_alloc(size_t n) {
+  hm_table t = calloc(1, sizeof *t);
+  if (!t) return NULL;
+  t->curves = calloc(n, sizeof *t->curves);
+  if (!t->curves) {
+    free(t);
+    return NULL;
+  }
+  t->n = n;
+  return t;
+}
+
+/* ---- lookup ---- */
+
+typedef struct {
+  int has_edge, has_outer;
+  double edge, outer;
+  size_t count; /* cycles at this speed */
+} curve_cycles;
+
+/* Basin edge and stable outer cycle of one curve at speed v (origin stable iff v < its Hopf speed). */
+static curve_cycles cycles_of(const tcurve *c, double v) {
+  double amp[64];
+  int stable[64];
+  size_t m = 0;
+  for (size_t i = 1; i < c->n && m < 64; ++i) {
+    const tpoint *a = &c->pts[i - 1], *b = &c->pts[i];
+    if ((a->v_kmh - v) * (b->v_kmh - v) > 0.0 || a->v_kmh == b->v_kmh) continue;
+    const double f = (v - a->v_kmh) / (b->v_kmh - a->v_kmh);
+    amp[m] = a->amp_m + f * (b->amp_m - a->amp_m);
+    stable[m] = a->stable && b->stable;
+    ++m;
+  }
+  curve_cycles r = {0, 0, 0.0, 0.0, m};
+  const int origin_stable = v < c->hopf_kmh;
+  if (!origin_stable) {
+    r.has_edge = 1; /* the origin itself is unstable: no margin at all */
+    r.edge = 0.0;
+  }
+  for (size_t i = 0; i < m; ++i) {
+    if (origin_stable && !stable[i] && (!r.has_edge || amp[i] < r.edge)) {
+      r.has_edge = 1;
+      r.edge = amp[i];
+    }
+  }
+  for (size_t i = 0; i < m; ++i)
+    if (stable[i] && (!r.has_edge || amp[i] > r.edge) && (!r.has_outer || amp[i] < r.outer)) {
+      r.has_outer = 1;
+      r.outer = amp[i];
+    }
+  return r;
+}
+
+hm_status hm_table_lookup(const hm_table t, double conicity, double speed_kmh, hm_table_lookup_result *out) {
+  if (!t || !out || t->n < 2) return HM_EINVAL;
+  if (!isfinite(conicity) || !isfinite(speed_kmh)) return HM_EDOMAIN;
+  hm_table_lookup_result r;
+  memset(&r, 0, sizeof r);
+  double c = conicity, v = speed_kmh;
+  const double cmin = t->curves[0].conicity, cmax = t->curves[t->n - 1].conicity;
+  if (c < cmin || c > cmax) {
+    c = fmin(fmax(c, cmin), cmax);
+    r.clamped = 1;
+  }
+  if (v < t->speed_min_kmh || v > t->speed_max_kmh) {
+    v = fmin(fmax(v, t->speed_min_kmh), t->speed_max_kmh);
+    r.clamped = 1;
+  }
+  size_t i = 0; /* bracketing curves i, i+1 (binary search on the sorted conicities) */
+  size_t lo = 0, hi = t->n - 1;
+  while (hi - lo > 1) {
+    const size_t mid = (lo + hi) / 2;
+    if (t->curves[mid].conicity <= c)
+      lo = mid;
+    else
+      hi = mid;
+  }
+  i = lo;
+  const tcurve *a = &t->curves[i], *b = &t->curves[i + 1];
+  const double w = (c - a->conicity) / (b->conicity - a->conicity);
+  r.conicity = c;
+  /* 1/V_hopf^2 is exactly linear in lambda(0) (linear.h: D is affine in lambda), so interpolate that; the
+   * other speeds scale with the Hopf speed (Klingel: V ~ 1/sqrt(lambda)), so interpolate their ratios to it
+   * and compare the neighbours' cycle families at the same fraction of their own Hopf speed. */
+  const double inv2 = 1.0 / (a->hopf_kmh * a->hopf_kmh) + w * (1.0 / (b->hopf_kmh * b->hopf_kmh) -
+                                                               1.0 / (a->hopf_kmh * a->hopf_kmh));
+  r.hopf_speed_kmh = 1.0 / sqrt(inv2);
+  r.l1 = a->l1 + w * (b->l1 - a->l1);
+  const double ra = a->lowest_kmh / a->hopf_kmh, rb = b->lowest_kmh / b->hopf_kmh;
+  r.lowest_cycle_speed_kmh = (ra + w * (rb - ra)) * r.hopf_speed_kmh;
+  r.origin_stable = speed_kmh < r.hopf_speed_kmh;
+  const double ratio = v / r.hopf_speed_kmh;
+  const curve_cycles ca = cycles_of(a, ratio * a->hopf_kmh), cb = cycles_of(b, ratio * b->hopf_kmh);
+  /* where only one neighbour has a cycle, take it (the smaller margin); otherwise interpolate */
+  if (ca.has_edge || cb.has_edge) {
+    r.has_edge = 1;
+    r.edge_amp_m = ca.has_edge && cb.has_edge ? ca.edge + w * (cb.edge - ca.edge) : ca.has_edge ? ca.edge : cb.edge;
+  }
+  if (!r.origin_stable) {
+    r.has_edge = 1;
+    r.edge_amp_m = 0.0;
+  }
+  if (ca.has_outer || cb.has_outer) {
+    r.has_stable_outer = 1;
+    r.stable_outer_amp_m =
+        ca.has_outer && cb.has_outer ? ca.outer + w * (cb.outer - ca.outer) : ca.has_outer ? ca.outer : cb.outer;
+  }
+  r.neighbour_spread_m = fmax(ca.has_edge && cb.has_edge ? fabs(ca.edge - cb.edge) : 0.0,
+                              ca.has_outer && cb.has_outer ? fabs(ca.outer - cb.outer) : 0.0);
+  r.consistent = ca.count == cb.count && ca.has_edge == cb.has_edge && ca.has_outer == cb.has_outer;
+  r.error_speed_kmh = fmax(t->err_hopf_kmh, t->err_lowest_kmh);
+  r.error_amp_m = t->err_amp_m;
+  *out = r;
+  return HM_OK;
+}
+
+size_t hm_table_size(const hm_table t, double *conicity_min, double *conicity_max) {
+  if (!t || t->n == 0) return 0;
+  if (conicity_min) *conicity_min = t->curves[0].conicity;
+  if (conicity_max) *conicity_max = t->curves[t->n - 1].conicity;
+  return t->n;
+}
+
+/* ---- build ---- */
+
+/* Keep the points needed for linear interpolation along the branch within 1 um and 0.01 km/h, every change
+ * of stability and both ends. Returns the number kept (in place). */
+static size_t decimate(tpoint *p, size_t n) {
+  if (n <= 2) return n;
+  size_t kept = 1, k = 0; /* p[0] kept */
+  size_t j = 1;
+  while (j < n) {
+    size_t best = j;
+    for (size_t e = j + 1; e < n; ++e) {
+      int ok = p[e].stable == p[k].stable && p[e - 1].stable == p[k].stable;
+      double s_total = 0.0;
+      for (size_t q = k + 1; q <= e; ++q)
+        s_total += hypot((p[q].v_kmh - p[q - 1].v_kmh) / 0.01, (p[q].amp_m - p[q - 1].amp_m) / 1e-6);
+      double s = 0.0;
+      for (size_t q = k + 1; q < e && ok; ++q) {
+        s += hypot((p[q].v_kmh - p[q - 1].v_kmh) / 0.01, (p[q].amp_m - p[q - 1].amp_m) / 1e-6);
+        const double f = s_total > 0.0 ? s / s_total : 0.0;
+        ok = fabs(p[k].v_kmh + f * (p[e].v_kmh - p[k].v_kmh) - p[q].v_kmh) <= 0.01 &&
+             fabs(p[k].amp_m + f * (p[e].amp_m - p[k].amp_m) - p[q].amp_m) <= 1e-6;
+      }
+      if (!ok) break;
+      best = e;
+    }
+    p[kept++] = p[best];
+    k = best;
+    j = best + 1;
+  }
+  return kept;
+}
+
+static hm_status curve_at(const hm_vehicle *veh, const hm_table_spec *spec, double conicity, tcurve *out) {
+  hm_vehicle v = *veh;
+  hm_status st = hm_vehicle_set_conicity_at_zero(&v, conicity);
+  if (st != HM_OK) return st;
+  hm_hopf_point h;
+  size_t n = 0;
+  if ((st = hm_hopf_find(&v, 500.0, HM_PARAM_SPEED, 1.0, 1e5, 1e-10, &h, 1, &n)) != HM_OK) return st;
+  if (n == 0) return HM_ENOCRIT;
+  hm_cycle_options o;
+  hm_cycle_options_default(&o, HM_PARAM_SPEED);
+  o.p_min = spec->speed_min_kmh;
+  o.p_max = fmax(spec->speed_max_kmh, 1.2 * h.speed_kmh);
+  o.amp_max_m = spec->amp_max_m;
+  o.rtol = spec->rtol;
+  o.atol = spec->rtol * 1e-3;
+  enum { CAP = 20000 };
+  hm_cycle_point *pts = malloc(CAP * sizeof *pts);
+  tpoint *tp = malloc(CAP * sizeof *tp);
+  hm_cycle_event ev[64];
+  size_t np = 0, ne = 0;
+  if (!pts || !tp) st = HM_ENOMEM;
+  if (st == HM_OK) st = hm_cycles_continue(&v, 500.0, &h, &o, pts, CAP, &np, ev, 64, &ne, NULL);
+  if (st == HM_OK) {
+    double lowest = h.speed_kmh;
+    for (size_t i = 0; i < np; ++i) {
+      tp[i] = (tpoint){pts[i].param, pts[i].amp_y_m, pts[i].stable};
+      lowest = fmin(lowest, pts[i].param);
+    }
+    /* start the polyline at the Hopf point itself (amplitude 0) */
+    memmove(tp + 1, tp, np * sizeof *tp);
+    tp[0] = (tpoint){h.speed_kmh, 0.0, tp[1].stable};
+    const size_t kept = decimate(tp, np + 1);
+    tpoint *shrunk = realloc(tp, kept * sizeof *tp);
+    if (shrunk) tp = shrunk;
+    *out = (tcurve){conicity, h.speed_kmh, h.l1, lowest, kept, tp};
+    tp = NULL;
+  }
+  free(pts);
+  free(tp);
+  return st;
+}
+
+/* Largest difference between the table (without the midpoint curve) and the computed midpoint curve. */
+static void midpoint_errors(hm_table t, const tcurve *mid, double *e_hopf, double *e_low, double *e_amp) {
+  hm_table_lookup_result r;
+  if (hm_table_lookup(t, mid->conicity, t->speed_min_kmh, &r) != HM_OK) return;
+  *e_hopf = fmax(*e_hopf, fabs(r.hopf_speed_kmh - mid->hopf_kmh));
+  *e_low = fmax(*e_low, fabs(r.lowest_cycle_speed_kmh - mid->lowest_kmh));
+  for (double v = t->speed_min_kmh; v <= t->speed_max_kmh; v += 5.0) {
+    const curve_cycles exact = cycles_of(mid, v);
+    if (hm_table_lookup(t, mid->conicity, v, &r) != HM_OK) continue;
+    /* near the lowest cycle speed, or where the neighbours disagree on which cycles exist (flagged per lookup),
+     * the error is the speed error above */
+    if (fabs(v - mid->lowest_kmh) <= 2.0 * *e_low + 1.0 || !r.consistent) continue;
+    if (exact.has_edge && r.has_edge) *e_amp = fmax(*e_amp, fabs(r.edge_amp_m - exact.edge));
+    if (exact.has_outer && r.has_stable_outer) *e_amp = fmax(*e_amp, fabs(r.stable_outer_amp_m - exact.outer));
+  }
+}
+
+static int spec_valid(const hm_table_spec *s) {
+  return s->n_conicity >= 2 && s->n_conicity <= 1000 && s->conicity_min > 0.0 &&
+         s->conicity_max > s->conicity_min && s->speed_min_kmh > 0.0 && s->speed_max_kmh > s->speed_min_kmh &&
+         s->amp_max_m > 1e-3 && s->rtol > 0.0;
+}
+
+hm_status hm_table_build(const hm_vehicle *veh, const hm_table_spec *spec, hm_table *out) {
+  if (!veh || !spec || !out || !spec_valid(spec)) return HM_EINVAL;
+  hm_status st = hm_vehicle_validate(veh, NULL, 0);
+  if (st != HM_OK) return st;
+  hm_table t = table_alloc(spec->n_conicity);
+  if (!t) return HM_ENOMEM;
+  t->kx_mn_m = veh->stiffness_long_n_m * 1e-6;
+  t->ky_mn_m = veh->stiffness_lat_n_m * 1e-6;
+  t->speed_min_kmh = spec->speed_min_kmh;
+  t->speed_max_kmh = spec->speed_max_kmh;
+  t->amp_max_m = spec->amp_max_m;
+  const double dc = (spec->conicity_max - spec->conicity_min) / (double)(spec->n_conicity - 1);
+  for (size_t i = 0; i < t->n && st == HM_OK; ++i) st = curve_at(veh, spec, spec->conicity_min + dc * (double)i, &t->curves[i]);
+  double e_hopf = 0.0, e_low = 0.0, e_amp = 0.0;
+  for (size_t i = 0; i + 1 < t->n && st == HM_OK; ++i) {
+    tcurve mid;
+    st = curve_at(veh, spec, spec->conicity_min + dc * ((double)i + 0.5), &mid);
+    if (st == HM_OK) {
+      midpoint_errors(t, &mid, &e_hopf, &e_low, &e_amp);
+      free(mid.pts);
+    }
+  }
+  if (st != HM_OK) {
+    hm_table_destroy(t);
+    return st;
+  }
+  t->err_hopf_kmh = e_hopf;
+  t->err_lowest_kmh = e_low;
+  t->err_amp_m = e_amp;
+  *out = t;
+  return HM_OK;
+}
+
+/* ---- text format ---- */
+
+typedef struct {
+  char *buf;
+  size_t len, used;
+} sink;
+
+static void put(sink *s, const char *fmt, ...) {
+  va_list ap;
+  va_start(ap, fmt);
+  char *dst = s->used < s->len ? s->buf + s->used : NULL;
+  const int n = vsnprintf(dst, dst ? s->len - s->used : 0, fmt, ap);
+  va_end(ap);
+  if (n > 0) s->used += (size_t)n;
+}
+
+hm_status hm_table_format(const hm_table t, char *buf, size_t len, size_t *needed) {
+  if (!t || !needed || (len && !buf)) return HM_EINVAL;
+  sink s = {buf, len, 0};
+  put(&s, "hunting_monitor_boundary_table 1\n");
+  put(&s, "# lambda(0) grid, Hopf speed, l1, lowest speed with a cycle; then the cycle family (v_kmh amplitude_m stable)\n");
+  put(&s, "kx_mn_m %.10g ky_mn_m %.10g speed_min_kmh %.10g speed_max_kmh %.10g amp_max_m %.10g\n", t->kx_mn_m,
+      t->ky_mn_m, t->speed_min_kmh, t->speed_max_kmh, t->amp_max_m);
+  put(&s, "error_hopf_kmh %.6g error_lowest_kmh %.6g error_edge_amp_m %.6g\n", t->err_hopf_kmh, t->err_lowest_kmh,
+      t->err_amp_m);
+  for (size_t i = 0; i < t->n; ++i) {
+    const tcurve *c = &t->curves[i];
+    put(&s, "conicity %.10g hopf_kmh %.10g l1 %.10g lowest_kmh %.10g n %zu\n", c->conicity, c->hopf_kmh, c->l1,
+        c->lowest_kmh, c->n);
+    for (size_t k = 0; k < c->n; ++k) put(&s, "%.9g %.7g %d\n", c->pts[k].v_kmh, c->pts[k].amp_m, c->pts[k].stable);
+  }
+  *needed = s.used + 1;
+  return s.used < len ? HM_OK : HM_EINVAL;
+}
+
+typedef struct {
+  const char *p, *end;
+  size_t line;
+  char *err;
+  size_t err_len;
+} reader;
+
+static hm_status perr(reader *r, const char *fmt, ...) {
+  if (r->err && r->err_len) {
+    int n = snprintf(r->err, r->err_len, "line %zu: ", r->line);
+    if (n > 0 && (size_t)n < r->err_len) {
+      va_list ap;
+      va_start(ap, fmt);
+      vsnprintf(r->err + n, r->err_len - (size_t)n, fmt, ap);
+      va_end(ap);
+    }
+  }
+  return HM_EPARSE;
+}
+
+/* Next non-empty, non-comment line into line[] (NUL-terminated); 0 at the end. */
+static int next_line(reader *r, char *line, size_t cap) {
+  while (r->p < r->end) {
+    const char *nl = memchr(r->p, '\n', (size_t)(r->end - r->p));
+    const char *e = nl ? nl : r->end;
+    size_t n = (size_t)(e - r->p);
+    ++r->line;
+    if (n >= cap) n = cap - 1;
+    memcpy(line, r->p, n);
+    line[n] = '\0';
+    r->p = nl ? nl + 1 : r->end;
+    const char *q = line;
+    while (*q == ' ' || *q == '\t' || *q == '\r') ++q;
+    if (*q && *q != '#') return 1;
+  }
+  return 0;
+}
+
+/* The next whitespace-separated token of *s (NUL-terminated in place), or NULL. */
+static char *token(char **s) {
+  char *p = *s;
+  while (*p == ' ' || *p == '\t' || *p == '\r') ++p;
+  if (!*p) return NULL;
+  char *start = p;
+  while (*p && *p != ' ' && *p != '\t' && *p != '\r') ++p;
+  if (*p) *p++ = '\0';
+  *s = p;
+  return start;
+}
+
+/* Parse "key value key value ..." with the given keys in order. */
+static hm_status keyed(reader *r, char *line, const char *const *keys, double *values, size_t n) {
+  char *save = line, *tok = token(&save);
+  for (size_t i = 0; i < n; ++i) {
+    if (!tok || strcmp(tok, keys[i]) != 0) return perr(r, "expected '%s'", keys[i]);
+    char *v = token(&save), *end = NULL;
+    if (!v) return perr(r, "'%s' needs a value", keys[i]);
+    errno = 0;
+    values[i] = strtod(v, &end);
+    if (*end || end == v || errno == ERANGE || !isfinite(values[i])) return perr(r, "'%s': bad number '%s'", keys[i], v);
+    tok = token(&save);
+  }
+  if (tok) return perr(r, "unexpected '%s'", tok);
+  return HM_OK;
+}
+
+static hm_status parse_curve(reader *r, char *line, tcurve *c, double prev_conicity) {
+  static const char *const keys[] = {"conicity", "hopf_kmh", "l1", "lowest_kmh", "n"};
+  double v[5];
+  hm_status st = keyed(r, line, keys, v, 5);
+  if (st != HM_OK) return st;
+  if (!(v[0] > prev_conicity)) return perr(r, "conicities must increase");
+  if (!(v[4] >= 1.0 && v[4] <= 1e6) || v[4] != floor(v[4])) return perr(r, "bad point count");
+  c->conicity = v[0];
+  c->hopf_kmh = v[1];
+  c->l1 = v[2];
+  c->lowest_kmh = v[3];
+  c->n = (size_t)v[4];
+  c->pts = malloc(c->n * sizeof *c->pts);
+  if (!c->pts) return HM_ENOMEM;
+  for (size_t k = 0; k < c->n; ++k) {
+    char buf[256], *end = NULL;
+    if (!next_line(r, buf, sizeof buf)) return perr(r, "missing cycle points (%zu of %zu)", k, c->n);
+    errno = 0;
+    const double vk = strtod(buf, &end);
+    char *e2 = NULL;
+    const double amp = strtod(end, &e2);
+    char *e3 = NULL;
+    const long stab = strtol(e2, &e3, 10);
+    while (*e3 == ' ' || *e3 == '\t' || *e3 == '\r') ++e3;
+    if (end == buf || e2 == end || e3 == e2 || *e3 || !isfinite(vk) || !isfinite(amp) || amp < 0.0 ||
+        (stab != 0 && stab != 1) || errno == ERANGE)
+      return perr(r, "expected 'v_kmh amplitude_m stable(0|1)'");
+    c->pts[k] = (tpoint){vk, amp, (int)stab};
+  }
+  return HM_OK;
+}
+
+hm_status hm_table_parse(const char *text, size_t len, hm_table *out, char *err, size_t err_len) {
+  if (!text || !out) return HM_EINVAL;
+  reader r = {text, text + len, 0, err, err_len};
+  char line[512];
+  if (!next_line(&r, line, sizeof line) || strcmp(line, "hunting_monitor_boundary_table 1") != 0)
+    return perr(&r, "not a hunting_monitor boundary table (version 1)");
+  static const char *const k1[] = {"kx_mn_m", "ky_mn_m", "speed_min_kmh", "speed_max_kmh", "amp_max_m"};
+  static const char *const k2[] = {"error_hopf_kmh", "error_lowest_kmh", "error_edge_amp_m"};
+  double h1[5], h2[3];
+  if (!next_line(&r, line, sizeof line)) return perr(&r, "missing header");
+  hm_status st = keyed(&r, line, k1, h1, 5);
+  if (st != HM_OK) return st;
+  if (!next_line(&r, line, sizeof line)) return perr(&r, "missing error line");
+  if ((st = keyed(&r, line, k2, h2, 3)) != HM_OK) return st;
+  if (!(h1[3] > h1[2])) return perr(&r, "speed range is empty");
+  /* count the curves first: every line starting with "conicity" */
+  size_t n = 0;
+  for (const char *q = r.p; q && q < r.end;) {
+    if ((size_t)(r.end - q) >= 9 && strncmp(q, "conicity ", 9) == 0) ++n;
+    const char *nl = memchr(q, '\n', (size_t)(r.end - q));
+    q = nl ? nl + 1 : NULL;
+  }
+  if (n < 2) return perr(&r, "at least two conicities are needed");
+  hm_table t = table_alloc(n);
+  if (!t) return HM_ENOMEM;
+  t->kx_mn_m = h1[0], t->ky_mn_m = h1[1], t->speed_min_kmh = h1[2], t->speed_max_kmh = h1[3], t->amp_max_m = h1[4];
+  t->err_hopf_kmh = h2[0], t->err_lowest_kmh = h2[1], t->err_amp_m = h2[2];
+  double prev = -INFINITY;
+  for (size_t i = 0; i < n && st == HM_OK; ++i) {
+    if (!next_line(&r, line, sizeof line)) {
+      st = perr(&r, "missing conicity record");
+      break;
+    }
+    st = parse_curve(&r, line, &t->curves[i], prev);
+    prev = t->curves[i].conicity;
+  }
+  if (st == HM_OK && next_line(&r, line, sizeof line)) st = perr(&r, "unexpected text after the last record");
+  if (st != HM_OK) {
+    hm_table_destroy(t);
+    return st;
+  }
+  *out = t;
+  return HM_OK;
+}
+
+hm_status hm_table_load_file(const char *path, hm_table *out, char *err, size_t err_len) {
+  if (!path || !out) return HM_EINVAL;
+  FILE *f = fopen(path, "rb");
+  if (!f) {
+    if (err && err_len) snprintf(err, err_len, "%s: cannot open: %s", path, strerror(errno));
+    return HM_EIO;
+  }
+  size_t cap = 1 << 16, n = 0;
+  char *buf = malloc(cap);
+  while (buf) {
+    n += fread(buf + n, 1, cap - n, f);
+    if (n < cap || cap >= ((size_t)64 << 20)) break;
+    char *bigger = realloc(buf, cap * 2);
+    if (!bigger) {
+      free(buf);
+      buf = NULL;
+      break;
+    }
+    buf = bigger;
+    cap *= 2;
+  }
+  const int bad = ferror(f);
+  fclose(f);
+  if (!buf) return HM_ENOMEM;
+  hm_status st = bad ? HM_EIO : hm_table_parse(buf, n, out, err, err_len);
+  if (bad && err && err_len) snprintf(err, err_len, "%s: read error", path);
+  free(buf);
+  return st;
+}

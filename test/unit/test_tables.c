@@ -1,0 +1,147 @@
+/* Boundary tables: lookups against closed forms and direct continuation, round trip, malformed files. */
+#include <stdlib.h>
+#include <string.h>
+
+#include "hm_test.h"
+#include "hunting_monitor/cycles.h"
+#include "hunting_monitor/linear.h"
+#include "hunting_monitor/tables.h"
+
+static hm_table table;
+static hm_vehicle vehicle;
+
+/* The Hopf speed from the table equals the closed form at any conicity (1/V^2 is affine in lambda). */
+static void hopf_lookup_is_exact(void) {
+  for (int i = 0; i < 50; ++i) {
+    const double c = hm_test_uniform(0.12, 0.16);
+    hm_table_lookup_result r;
+    HM_CHECK(hm_table_lookup(table, c, 400.0, &r) == HM_OK, "lookup");
+    double v;
+    HM_CHECK(hm_linear_critical_speed(&vehicle, c, &v) == HM_OK, "closed form");
+    HM_CHECK_REL(r.hopf_speed_kmh, hm_kmh_from_mps(v), 1e-9, "table Hopf speed vs closed form");
+    HM_CHECK(r.origin_stable == (400.0 < r.hopf_speed_kmh) && !r.clamped, "flags");
+  }
+}
+
+/* At lambda(0) = 0.1358 (between grid points): MODEL.md section 7 and a direct continuation agree with the
+ * lookup within the table's stated errors. */
+static void lookup_matches_direct_continuation(void) {
+  hm_table_lookup_result r;
+  HM_CHECK(hm_table_lookup(table, 0.1358, 420.0, &r) == HM_OK, "lookup");
+  printf("  stated errors: speeds %.3f km/h, amplitudes %.3f mm\n", r.error_speed_kmh, r.error_amp_m * 1e3);
+  HM_CHECK_DELTA(r.lowest_cycle_speed_kmh, 239.5, r.error_speed_kmh + 0.1, "lowest cycle speed (MODEL: ~239.5)");
+  HM_CHECK(r.has_edge && r.consistent, "an edge at 420 km/h");
+  HM_CHECK_DELTA(r.edge_amp_m, 8.2e-3, r.error_amp_m + 0.05e-3, "edge at 420 km/h (MODEL: about 8.2 mm)");
+  /* direct: the family at lambda(0) = 0.1358 */
+  hm_hopf_point h;
+  size_t n;
+  hm_hopf_find(&vehicle, 500.0, HM_PARAM_SPEED, 100.0, 900.0, 1e-10, &h, 1, &n);
+  hm_cycle_options o;
+  hm_cycle_options_default(&o, HM_PARAM_SPEED);
+  o.p_min = 150.0;
+  o.p_max = 700.0;
+  o.amp_max_m = 0.016;
+  enum { CAP = 5000 };
+  hm_cycle_point *pts = malloc(CAP * sizeof *pts);
+  hm_cycle_event ev[16];
+  size_t np = 0, ne = 0;
+  HM_CHECK(hm_cycles_continue(&vehicle, 500.0, &h, &o, pts, CAP, &np, ev, 16, &ne, NULL) == HM_OK, "family");
+  const double speeds[] = {300.0, 400.0, 480.0};
+  for (int k = 0; k < 3; ++k) {
+    double edge = INFINITY;
+    for (size_t i = 1; i < np; ++i) {
+      const hm_cycle_point *a = &pts[i - 1], *b = &pts[i];
+      if ((a->param - speeds[k]) * (b->param - speeds[k]) > 0.0 || a->stable || b->stable) continue;
+      const double f = (speeds[k] - a->param) / (b->param - a->param);
+      edge = fmin(edge, a->amp_y_m + f * (b->amp_y_m - a->amp_y_m));
+    }
+    HM_CHECK(hm_table_lookup(table, 0.1358, speeds[k], &r) == HM_OK, "lookup");
+    printf("  V %.0f: edge direct %.4f mm, table %.4f mm\n", speeds[k], edge * 1e3, r.edge_amp_m * 1e3);
+    HM_CHECK_DELTA(r.edge_amp_m, edge, r.error_amp_m, "edge amplitude within the stated error");
+  }
+  free(pts);
+}
+
+/* format -> parse -> format reproduces the text; lookups agree. */
+static void round_trip(void) {
+  size_t need = 0;
+  HM_CHECK(hm_table_format(table, NULL, 0, &need) == HM_EINVAL && need > 100, "size query");
+  char *a = malloc(need), *b = malloc(need);
+  HM_CHECK(hm_table_format(table, a, need, &need) == HM_OK, "format");
+  hm_table t2 = NULL;
+  char err[128] = "";
+  HM_CHECK(hm_table_parse(a, need - 1, &t2, err, sizeof err) == HM_OK, "parse: %s", err);
+  size_t need2 = 0;
+  HM_CHECK(t2 && hm_table_format(t2, b, need, &need2) == HM_OK && need2 == need && strcmp(a, b) == 0, "same text");
+  hm_table_lookup_result r1, r2;
+  hm_table_lookup(table, 0.137, 333.0, &r1);
+  hm_table_lookup(t2, 0.137, 333.0, &r2);
+  HM_CHECK_DELTA(r2.edge_amp_m, r1.edge_amp_m, 1e-9, "lookup after round trip");
+  hm_table_destroy(t2);
+  free(a);
+  free(b);
+}
+
+static void malformed_tables(void) {
+  const char *good_head = "hunting_monitor_boundary_table 1\n"
+                          "kx_mn_m 8.96 ky_mn_m 8.96 speed_min_kmh 150 speed_max_kmh 700 amp_max_m 0.016\n"
+                          "error_hopf_kmh 0 error_lowest_kmh 0.1 error_edge_amp_m 1e-4\n";
+  const struct {
+    const char *body, *message;
+  } cases[] = {
+      {"conicity 0.1 hopf_kmh 600 l1 1 lowest_kmh 250 n 1\n600 0 1\n", "at least two conicities"},
+      {"conicity 0.1 hopf_kmh 600 l1 1 lowest_kmh 250 n 1\n600 0 1\nconicity 0.2 hopf_kmh 500 l1 1 "
+       "lowest_kmh 250 n 2\n500 0 1\n",
+       "missing cycle points (1 of 2)"},
+      {"conicity 0.1 hopf_kmh 600 l1 1 lowest_kmh 250 n 1\n600 x 1\nconicity 0.2 hopf_kmh 500 l1 1 "
+       "lowest_kmh 250 n 1\n500 0 1\n",
+       "line 5: expected 'v_kmh amplitude_m stable(0|1)'"},
+      {"conicity 0.2 hopf_kmh 600 l1 1 lowest_kmh 250 n 1\n600 0 1\nconicity 0.1 hopf_kmh 500 l1 1 "
+       "lowest_kmh 250 n 1\n500 0 1\n",
+       "line 6: conicities must increase"},
+      {"conicity 0.1 hopf_kmh nan l1 1 lowest_kmh 250 n 1\n600 0 1\nconicity 0.2 hopf_kmh 500 l1 1 "
+       "lowest_kmh 250 n 1\n500 0 1\n",
+       "line 4: 'hopf_kmh': bad number 'nan'"},
+      {"conicity 0.1 hopf_kmh 600 l1 1 lowest_kmh 250 n 1\n600 0 2\nconicity 0.2 hopf_kmh 500 l1 1 "
+       "lowest_kmh 250 n 1\n500 0 1\n",
+       "line 5: expected"},
+  };
+  for (size_t i = 0; i < sizeof cases / sizeof cases[0]; ++i) {
+    char text[1024], err[160] = "";
+    snprintf(text, sizeof text, "%s%s", good_head, cases[i].body);
+    hm_table t = (hm_table)0x1;
+    const hm_status st = hm_table_parse(text, strlen(text), &t, err, sizeof err);
+    HM_CHECK(st == HM_EPARSE, "case %zu: %s", i, hm_status_str(st));
+    HM_CHECK(strstr(err, cases[i].message) != NULL, "case %zu: '%s' lacks '%s'", i, err, cases[i].message);
+    HM_CHECK(t == (hm_table)0x1, "case %zu: output changed on failure", i);
+  }
+  char err[160] = "";
+  hm_table t = NULL;
+  HM_CHECK(hm_table_parse("not a table\n", 12, &t, err, sizeof err) == HM_EPARSE && strstr(err, "line 1"), "%s", err);
+  HM_CHECK(hm_table_load_file("/nonexistent.tbl", &t, err, sizeof err) == HM_EIO, "missing file");
+  hm_table_lookup_result r;
+  memset(&r, 0x33, sizeof r);
+  const hm_table_lookup_result before = r;
+  HM_CHECK(hm_table_lookup(table, NAN, 300.0, &r) == HM_EDOMAIN, "NaN conicity");
+  HM_CHECK(hm_table_lookup(table, 0.13, INFINITY, &r) == HM_EDOMAIN, "infinite speed");
+  HM_CHECK(memcmp(&r, &before, sizeof r) == 0, "lookup output changed on failure");
+}
+
+int main(void) {
+  hm_vehicle_default(&vehicle);
+  hm_table_spec spec;
+  hm_table_spec_default(&spec);
+  spec.conicity_min = 0.12;
+  spec.conicity_max = 0.16;
+  spec.n_conicity = 3;
+  if (hm_table_build(&vehicle, &spec, &table) != HM_OK) {
+    printf("FAIL table_build\n");
+    return 1;
+  }
+  HM_RUN(hopf_lookup_is_exact);
+  HM_RUN(lookup_matches_direct_continuation);
+  HM_RUN(round_trip);
+  HM_RUN(malformed_tables);
+  hm_table_destroy(table);
+  HM_TEST_EXIT();
+}
