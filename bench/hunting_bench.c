@@ -1,7 +1,12 @@
 /* hunting_bench: throughput and wall-time figures of the C core, printed as JSON (not a test). */
 #define _POSIX_C_SOURCE 200809L
 #include <stdio.h>
+#include <stdlib.h>
 #include <time.h>
+
+#include "hunting_monitor/cycles.h"
+#include "hunting_monitor/hopf.h"
+#include "hunting_monitor/tables.h"
 
 #include "hunting_monitor/integrate.h"
 #include "hunting_monitor/linear.h"
@@ -11,6 +16,129 @@ static double now_s(void) {
   struct timespec ts;
   clock_gettime(CLOCK_MONOTONIC, &ts);
   return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
+}
+
+/* Kx = 9.7, Ky = 10.96 (MODEL.md section 6): from the parameters to both located folds (Hopf point, family of
+ * cycles to 6.5 mm, just past LPC2 at 5.98 mm). Returns the wall time of the fastest of `reps` runs. */
+static double bench_folds(int reps, double *lpc1, double *lpc2) {
+  double best = 1e30;
+  enum { CAP = 4000 };
+  hm_cycle_point *pts = malloc(CAP * sizeof *pts);
+  for (int r = 0; r < reps; ++r) {
+    const double t0 = now_s();
+    hm_vehicle v;
+    hm_vehicle_default(&v);
+    v.stiffness_long_n_m = 9.7e6;
+    v.stiffness_lat_n_m = 10.96e6;
+    hm_hopf_point h;
+    size_t n = 0, np = 0, ne = 0;
+    hm_hopf_find(&v, 500.0, HM_PARAM_SPEED, 100.0, 900.0, 1e-10, &h, 1, &n);
+    hm_cycle_options o;
+    hm_cycle_options_default(&o, HM_PARAM_SPEED);
+    o.amp_max_m = 0.0065;
+    hm_cycle_event ev[8];
+    hm_cycles_continue(&v, 500.0, &h, &o, pts, CAP, &np, ev, 8, &ne, NULL);
+    const double dt = now_s() - t0;
+    if (dt < best) best = dt;
+    if (ne >= 2) {
+      *lpc1 = ev[0].point.param;
+      *lpc2 = ev[1].point.param;
+    }
+  }
+  free(pts);
+  return best;
+}
+
+/* The whole family of the default vehicle, 150..700 km/h up to 16 mm (three folds, two branch points). */
+static double bench_family(size_t *n_points) {
+  enum { CAP = 20000 };
+  hm_cycle_point *pts = malloc(CAP * sizeof *pts);
+  const double t0 = now_s();
+  hm_vehicle v;
+  hm_vehicle_default(&v);
+  hm_hopf_point h;
+  size_t n = 0, ne = 0;
+  hm_hopf_find(&v, 500.0, HM_PARAM_SPEED, 100.0, 900.0, 1e-10, &h, 1, &n);
+  hm_cycle_options o;
+  hm_cycle_options_default(&o, HM_PARAM_SPEED);
+  o.p_min = 150.0;
+  o.p_max = 700.0;
+  o.amp_max_m = 0.016;
+  hm_cycle_event ev[16];
+  hm_cycles_continue(&v, 500.0, &h, &o, pts, CAP, n_points, ev, 16, &ne, NULL);
+  const double dt = now_s() - t0;
+  free(pts);
+  return dt;
+}
+
+/* LPC curve over Kx in [9.0, 10.7] at Ky = 10.96 from the parameters: Hopf point, family to 7.5 mm, the folds,
+ * then the two-parameter continuation of the fold curve in both directions with its cusp. */
+static double bench_lpc_curve(double *cusp_kx, size_t *n_points) {
+  enum { CAP = 4000 };
+  hm_cycle_point *pts = malloc(CAP * sizeof *pts);
+  hm_lpc_point *lp = malloc(CAP * sizeof *lp);
+  const double t0 = now_s();
+  hm_vehicle v;
+  hm_vehicle_default(&v);
+  v.stiffness_long_n_m = 9.85e6;
+  v.stiffness_lat_n_m = 10.96e6;
+  hm_hopf_point h;
+  size_t n = 0, np = 0, ne = 0, nc = 0;
+  hm_hopf_find(&v, 500.0, HM_PARAM_SPEED, 100.0, 900.0, 1e-10, &h, 1, &n);
+  hm_cycle_options o;
+  hm_cycle_options_default(&o, HM_PARAM_SPEED);
+  o.amp_max_m = 0.0075;
+  hm_cycle_event ev[8];
+  hm_cycles_continue(&v, 500.0, &h, &o, pts, CAP, &np, ev, 8, &ne, NULL);
+  hm_lpc_options lo;
+  hm_lpc_options_default(&lo, HM_PARAM_KX);
+  lo.p2_min = 9.0;
+  lo.p2_max = 10.7;
+  hm_lpc_point cusp;
+  if (ne > 0) hm_lpc_curve(&v, 500.0, &o, &lo, &ev[0], lp, CAP, n_points, &cusp, 1, &nc, NULL);
+  const double dt = now_s() - t0;
+  *cusp_kx = nc ? cusp.p2 : -1.0;
+  free(pts);
+  free(lp);
+  return dt;
+}
+
+/* A boundary table of 3 conicities (built once, not timed): parse time and lookup time. */
+static void bench_table(double *parse_us, double *lookup_ns, size_t *bytes) {
+  hm_vehicle v;
+  hm_vehicle_default(&v);
+  hm_table_spec spec;
+  hm_table_spec_default(&spec);
+  spec.conicity_min = 0.12;
+  spec.conicity_max = 0.16;
+  spec.n_conicity = 3;
+  hm_table t = NULL;
+  *parse_us = *lookup_ns = -1.0;
+  if (hm_table_build(&v, &spec, &t) != HM_OK) return;
+  size_t need = 0;
+  hm_table_format(t, NULL, 0, &need);
+  char *buf = malloc(need);
+  hm_table_format(t, buf, need, &need);
+  *bytes = need - 1;
+  const int reps = 200;
+  double t0 = now_s();
+  for (int i = 0; i < reps; ++i) {
+    hm_table t2 = NULL;
+    hm_table_parse(buf, need - 1, &t2, NULL, 0);
+    hm_table_destroy(t2);
+  }
+  *parse_us = (now_s() - t0) / reps * 1e6;
+  hm_table_lookup_result r;
+  volatile double acc = 0.0;
+  const long n = 2000000;
+  t0 = now_s();
+  for (long i = 0; i < n; ++i) {
+    hm_table_lookup(t, 0.12 + 0.04 * (double)(i % 1000) / 1000.0, 200.0 + (double)(i % 5000) * 0.1, &r);
+    acc += r.edge_amp_m;
+  }
+  *lookup_ns = (now_s() - t0) / (double)n * 1e9;
+  free(buf);
+  hm_table_destroy(t);
 }
 
 int main(void) {
@@ -60,6 +188,13 @@ int main(void) {
   const double sim_s = now_s() - t0;
   hm_dopri_destroy(integ);
 
+  double lpc1 = 0.0, lpc2 = 0.0, cusp_kx = 0.0, parse_us, lookup_ns;
+  size_t family_points = 0, lpc_points = 0, table_bytes = 0;
+  const double folds_s = bench_folds(20, &lpc1, &lpc2);
+  const double family_s = bench_family(&family_points);
+  const double lpc_s = bench_lpc_curve(&cusp_kx, &lpc_points);
+  bench_table(&parse_us, &lookup_ns, &table_bytes);
+
   printf("{\n");
   printf("  \"closed_form_critical_speeds_per_s\": %.4g,\n", closed_per_s);
   printf("  \"eigenvalue_bisection_critical_speeds_per_s\": %.4g,\n", eig_per_s);
@@ -68,7 +203,17 @@ int main(void) {
   printf("  \"simulate_100s_at_543kmh_rtol1e-9_wall_s\": %.4g,\n", sim_s);
   printf("  \"simulate_status\": \"%s\",\n", hm_status_str(st));
   printf("  \"simulate_steps\": %zu,\n", stats.n_accepted + stats.n_rejected);
-  printf("  \"simulate_rhs_evaluations\": %zu\n", stats.n_rhs);
+  printf("  \"simulate_rhs_evaluations\": %zu,\n", stats.n_rhs);
+  printf("  \"folds_kx9.7_from_parameters_ms\": %.4g,\n", folds_s * 1e3);
+  printf("  \"folds_kx9.7_kmh\": [%.6f, %.6f],\n", lpc1, lpc2);
+  printf("  \"whole_family_default_vehicle_ms\": %.4g,\n", family_s * 1e3);
+  printf("  \"whole_family_points\": %zu,\n", family_points);
+  printf("  \"lpc_curve_kx_9.0_10.7_ms\": %.4g,\n", lpc_s * 1e3);
+  printf("  \"lpc_curve_points\": %zu,\n", lpc_points);
+  printf("  \"lpc_curve_cusp_kx\": %.6f,\n", cusp_kx);
+  printf("  \"table_bytes_3_conicities\": %zu,\n", table_bytes);
+  printf("  \"table_parse_us\": %.4g,\n", parse_us);
+  printf("  \"table_lookup_ns\": %.4g\n", lookup_ns);
   printf("}\n");
   return sink == 12345.678 ? 1 : 0;
 }

@@ -44,8 +44,9 @@ typedef struct {
   int use_symmetry;         /* 1: half-period shooting when the vehicle is odd-symmetric; 0: never */
 } hm_cycle_options;
 
-/* Defaults for parameter p: a wide range, 20 mm amplitude limit, ds 0.05..5, 2000 steps, rtol 1e-10,
- * atol 1e-13, Newton 1e-9 (8 iterations), location to 1e-9, symmetry on. */
+/* Defaults for parameter p: a wide range, 20 mm amplitude limit, ds 0.2 (0.0001..5), 2000 steps,
+ * rtol 1e-9, atol 1e-12 (fold speeds then agree with rtol 1e-12 to 1e-6 km/h), Newton 1e-9 (8 iterations),
+ * location to 1e-9, symmetry on. */
 void hm_cycle_options_default(hm_cycle_options *opt, hm_param p);
 
 typedef struct {

@@ -31,8 +31,8 @@ void hm_cycle_options_default(hm_cycle_options *opt, hm_param p) {
   opt->ds_min = 1e-4;
   opt->ds_max = 5.0;
   opt->max_steps = 2000;
-  opt->rtol = 1e-10;
-  opt->atol = 1e-13;
+  opt->rtol = 1e-9;
+  opt->atol = 1e-12;
   opt->newton_tol = 1e-9;
   opt->newton_max_iter = 8;
   opt->locate_tol = 1e-9;

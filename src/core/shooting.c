@@ -28,7 +28,8 @@ hm_status hm_sh_init(hm_sh *c, const hm_vehicle *veh, double speed_kmh, const hm
   c->symmetric = opt->use_symmetry && hm_conicity_is_even(&veh->conicity, 1e-12);
   const double sc[NW] = {1e-3, 1e-3, 1e-1, 1e-2, hm_sh_param_scale(opt->param), hm_sh_param_scale(param2)};
   memcpy(c->sc, sc, sizeof sc);
-  c->integ = hm_dopri_create(NZ);
+  /* without p2 its sensitivity columns are left out of the integration (and of the error control) */
+  c->integ = hm_dopri_create(has_param2 ? NZ : NZ - NX);
   return c->integ ? HM_OK : HM_ENOMEM;
 }
 
@@ -96,7 +97,7 @@ hm_status hm_sh_shoot(hm_sh *c, const double *u, hm_shot *s) {
   const double tau = c->symmetric ? 0.5 * T : T, sigma = c->symmetric ? -1.0 : 1.0;
   c->amp_y = fabs(x0[0]);
   c->amp_psi = fabs(x0[2]);
-  const hm_ode_system sys = {NZ, aug_rhs, NULL, c};
+  const hm_ode_system sys = {c->has_param2 ? NZ : NZ - NX, aug_rhs, NULL, c};
   const hm_dopri_options dopt = {c->opt->rtol, c->opt->atol, 0.0, 0.0, 0};
   st = hm_dopri_integrate(c->integ, &sys, &dopt, 0.0, tau, z, NULL, amp_observer, c, NULL);
   if (st != HM_OK) return st;
