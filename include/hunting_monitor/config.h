@@ -50,6 +50,15 @@ hm_status hm_config_parse_vehicle(const char *text, size_t len, const char *sour
 /* Read the file at path and parse it as above; HM_EIO if it cannot be read. */
 hm_status hm_config_load_vehicle(const char *path, hm_vehicle *veh, char *name, char *err, size_t err_len);
 
+/*
+ * Write veh as a complete vehicle config (the format above, values with 17 significant digits so that parsing
+ * gives back the same doubles) into buf of len bytes; name may be NULL; comment (may be NULL) is written as
+ * '#' lines at the top. *needed receives the size including the terminating NUL; HM_EINVAL if len is too
+ * small (call again with *needed bytes).
+ */
+hm_status hm_config_format_vehicle(const hm_vehicle *veh, const char *name, const char *comment, char *buf,
+                                   size_t len, size_t *needed);
+
 #ifdef __cplusplus
 }
 #endif

@@ -232,3 +232,93 @@ void jw_bool(json_writer *w, const char *key, int value) {
 }
 
 void jw_finish(json_writer *w) { fputc('\n', w->f); }
+
+/* ---- CSV ---- */
+
+static char *trim(char *s) {
+  while (*s == ' ' || *s == '\t') ++s;
+  char *e = s + strlen(s);
+  while (e > s && (e[-1] == ' ' || e[-1] == '\t' || e[-1] == '\r' || e[-1] == '\n')) *--e = '\0';
+  return s;
+}
+
+/* Split line at commas into at most max fields; returns the count. */
+static int split_commas(char *line, char **fields, int max) {
+  int k = 0;
+  char *p = line;
+  while (k < max) {
+    char *comma = strchr(p, ',');
+    if (comma) *comma = '\0';
+    fields[k++] = trim(p);
+    if (!comma) break;
+    p = comma + 1;
+  }
+  return strchr(p, ',') ? max + 1 : k;
+}
+
+int cli_read_csv(const char *path, int ncols, char header[][64], double **data, size_t *n) {
+  FILE *f = fopen(path, "r");
+  if (!f) {
+    fprintf(stderr, "hunting: %s: cannot open: %s\n", path, strerror(errno));
+    return 1;
+  }
+  char line[1024];
+  size_t lineno = 0, rows = 0, cap = 0;
+  double *d = NULL;
+  int have_header = 0, rc = 0;
+  while (rc == 0 && fgets(line, sizeof line, f)) {
+    ++lineno;
+    if (!strchr(line, '\n') && !feof(f)) {
+      fprintf(stderr, "hunting: %s:%zu: line too long\n", path, lineno);
+      rc = 1;
+      break;
+    }
+    char *t = trim(line);
+    if (!*t || *t == '#') continue;
+    char *fields[16];
+    const int k = split_commas(t, fields, 16);
+    if (k != ncols) {
+      fprintf(stderr, "hunting: %s:%zu: expected %d comma-separated columns, found %d\n", path, lineno, ncols, k);
+      rc = 1;
+      break;
+    }
+    if (!have_header) {
+      for (int c = 0; c < ncols; ++c) snprintf(header[c], 64, "%s", fields[c]);
+      have_header = 1;
+      continue;
+    }
+    if (rows == cap) {
+      cap = cap ? 2 * cap : 256;
+      double *bigger = realloc(d, cap * (size_t)ncols * sizeof(double));
+      if (!bigger) {
+        fprintf(stderr, "hunting: %s: out of memory\n", path);
+        rc = 1;
+        break;
+      }
+      d = bigger;
+    }
+    for (int c = 0; c < ncols && rc == 0; ++c)
+      if (parse_double(fields[c], &d[rows * (size_t)ncols + (size_t)c])) {
+        fprintf(stderr, "hunting: %s:%zu: column '%s': expected a finite number, got '%s'\n", path, lineno,
+                header[c], fields[c]);
+        rc = 1;
+      }
+    ++rows;
+  }
+  if (rc == 0 && ferror(f)) {
+    fprintf(stderr, "hunting: %s: read error\n", path);
+    rc = 1;
+  }
+  fclose(f);
+  if (rc == 0 && !have_header) {
+    fprintf(stderr, "hunting: %s: no header line\n", path);
+    rc = 1;
+  }
+  if (rc != 0) {
+    free(d);
+    return rc;
+  }
+  *data = d;
+  *n = rows;
+  return 0;
+}

@@ -64,6 +64,14 @@ void jw_bool(json_writer *w, const char *key, int value);
 /* Ends the document with a newline. */
 void jw_finish(json_writer *w);
 
+/*
+ * Read a CSV file with a header line and ncols numeric columns ('#' comment lines and blank lines skipped).
+ * header[k] receives the k-th column name (trimmed, up to 63 characters); *data (malloc'd, row-major
+ * n x ncols) and *n the rows. Prints "hunting: FILE:LINE: reason" and returns nonzero on any error (missing
+ * file, wrong column count, a value that is not a finite number).
+ */
+int cli_read_csv(const char *path, int ncols, char header[][64], double **data, size_t *n);
+
 /* Commands implemented in cmd_bifurcation.c */
 extern const cli_option hopf_opts[], cycles_opts[], hopf_curve_opts[], lpc_curve_opts[];
 int cmd_hopf(const cli_args *a);
@@ -73,6 +81,8 @@ int cmd_lpc_curve(const cli_args *a);
 extern const cli_option tables_opts[], table_lookup_opts[];
 int cmd_tables(const cli_args *a);
 int cmd_table_lookup(const cli_args *a);
+extern const cli_option fit_conicity_opts[];
+int cmd_fit_conicity(const cli_args *a);
 int cli_fail_status(const char *what, hm_status st);
 int cli_speed_option(const cli_args *a, double *v_kmh);
 

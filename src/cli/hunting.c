@@ -389,6 +389,11 @@ static const command commands[] = {
      "Boundaries at one conicity and speed from a table: Hopf and lowest cycle speeds, the unstable cycle (edge\n"
      "of the basin of the stable origin) and the stable cycle beyond it; null where none exists.",
      table_lookup_opts, cmd_table_lookup},
+    {"fit-conicity", "fit lambda(y) to measured equivalent conicity", "DATA.csv [--terms N] [--symmetric] [options]",
+     "Least-squares fit (Levenberg-Marquardt) of lambda(y) = constant + N Gaussians to a CSV with header\n"
+     "y_m,conicity (or y_mm,conicity with --y-unit mm): parameters with standard errors, SSE, R^2, adjusted\n"
+     "R^2, RMSE, lambda(0) and the vehicle's Hopf speed with it; --write-config writes a vehicle config.",
+     fit_conicity_opts, cmd_fit_conicity},
     {"sweep", "linear critical speed over a conicity range", "[--from L --to L --n COUNT] [--table]",
      "Linear critical speed over a range of equivalent conicities (JSON, or a table with --table).", sweep_opts,
      cmd_sweep},
@@ -415,7 +420,8 @@ int main(int argc, char **argv) {
     const command *c = &commands[i];
     if (strcmp(argv[1], c->name) != 0) continue;
     cli_args args;
-    if (cli_parse(c->name, argc - 2, argv + 2, c->opts, 0, &args)) return 2;
+    const int positional = c->run == cmd_fit_conicity; /* the data file */
+    if (cli_parse(c->name, argc - 2, argv + 2, c->opts, positional, &args)) return 2;
     if (cli_has(&args, "help")) {
       cli_print_help(stdout, c->name, c->usage, c->summary, c->opts);
       return 0;

@@ -146,7 +146,7 @@ def test_help_is_available():
     p = run("--help")
     assert "critical" in p.stdout and "simulate" in p.stdout
     for cmd in ["critical", "critical-conicity", "eig", "simulate", "lyapunov", "sweep", "hopf", "cycles",
-                "hopf-curve", "lpc-curve"]:
+                "hopf-curve", "lpc-curve", "tables", "table-lookup", "fit-conicity"]:
         p = run(cmd, "--help")
         assert p.stdout.startswith(f"usage: hunting {cmd}"), p.stdout
     assert run(ok=False).returncode == 2
@@ -251,6 +251,86 @@ def test_bifurcation_bad_input():
         p = run(*args, ok=False)
         assert p.returncode != 0, f"{args} exited 0"
         assert message in p.stderr, f"{args}: stderr {p.stderr!r} lacks {message!r}"
+
+
+def sample_path():
+    return os.path.join(SRC, "config", "conicity_samples", "crh380_worn_synthetic.csv")
+
+
+def test_fit_conicity_sample_and_config():
+    out = run_json("fit-conicity", sample_path(), "--terms", "2", "--symmetric")
+    # the generating curve (MODEL.md's raw fit) has its peaks at +-9.88 mm with widths 1.46 mm and amplitude 0.70
+    g = sorted(out["gaussians"], key=lambda t: t["center_m"])
+    close(g[1]["center_m"], 0.00988, 3 * g[1]["center_m_stderr"] + 1e-5, "peak centre")
+    close(g[1]["width_m"], 0.00146, 3 * g[1]["width_m_stderr"] + 2e-5, "peak width")
+    assert out["n_points"] == 121 and out["dof"] == 117, out
+    # noise sigma 0.0157 (MODEL.md's reported RMSE): the fit's RMSE is that within sampling error (~7% for 117 dof)
+    close(out["rmse"], 0.0157, 0.25 * 0.0157, "rmse")
+    assert 0.99 < out["r2"] < 1 and out["adj_r2"] < out["r2"], out
+    with tempfile.TemporaryDirectory() as d:
+        cfg = os.path.join(d, "fitted.yaml")
+        out2 = run_json("fit-conicity", sample_path(), "--terms", "2", "--symmetric", "--write-config", cfg)
+        crit = run_json("critical", "--config", cfg)
+        close(crit["v_crit_kmh"], out2["hopf_kmh"], 1e-6, "Hopf speed of the written config")
+        close(crit["conicity"], out2["conicity_at_zero"], 1e-12, "lambda(0) of the written config")
+        # the same data in millimetres
+        mm = os.path.join(d, "mm.csv")
+        with open(sample_path()) as f, open(mm, "w") as g2:
+            for line in f:
+                if line.startswith("#"):
+                    continue
+                if line.startswith("y_m"):
+                    g2.write("y_mm,conicity\n")
+                    continue
+                y, c = line.strip().split(",")
+                g2.write(f"{float(y) * 1000:.4f},{c}\n")
+        out3 = run_json("fit-conicity", mm, "--y-unit", "mm", "--terms", "2", "--symmetric")
+        close(out3["sse"], out["sse"], 1e-9, "same fit from millimetres")
+
+
+def test_fit_conicity_bad_input():
+    with tempfile.TemporaryDirectory() as d:
+        def write(name, text):
+            path = os.path.join(d, name)
+            with open(path, "w") as f:
+                f.write(text)
+            return path
+        cases = [
+            ([os.path.join(d, "missing.csv")], "cannot open"),
+            ([write("hdr.csv", "y,lambda\n0,0.1\n")], "the header must be 'y_m,conicity'"),
+            ([write("nan.csv", "y_m,conicity\n0.001,0.2\n0.002,nan\n")], "nan.csv:3: column 'conicity': expected a finite number"),
+            ([write("cols.csv", "y_m,conicity\n0.001,0.2,7\n")], "cols.csv:2: expected 2 comma-separated columns"),
+            ([write("few.csv", "y_m,conicity\n0.001,0.2\n0.002,0.3\n0.003,0.1\n"), "--terms", "2"],
+             "3 points cannot determine 7 parameters"),
+            ([write("flat.csv", "y_m,conicity\n" + "".join(f"{i * 1e-3},0.2\n" for i in range(20)))],
+             "the conicity is constant"),
+            ([sample_path(), "--terms", "9"], "--terms must be an integer in 1..8"),
+            ([sample_path(), "--y-unit", "inch"], "--y-unit must be m or mm"),
+            ([], "give the data file"),
+        ]
+        for args, message in cases:
+            p = run("fit-conicity", *args, ok=False)
+            assert p.returncode != 0, f"{args} exited 0"
+            assert message in p.stderr, f"{args}: stderr {p.stderr!r} lacks {message!r}"
+
+
+def test_tables_and_lookup():
+    with tempfile.TemporaryDirectory() as d:
+        tbl = os.path.join(d, "default.tbl")
+        out = run_json("tables", "--out", tbl, "--conicity-min", "0.12", "--conicity-max", "0.16", "--n", "3")
+        assert out["conicities"] == 3 and out["error_speed_kmh"] < 1.0, out
+        look = run_json("table-lookup", "--table", tbl, "--conicity", "0.1358", "--v", "420")
+        # Hopf speed: exact (the closed form at this conicity); basin edge: MODEL.md section 7, about 8.2 mm
+        close(look["hopf_kmh"], run_json("critical", "--conicity", "0.1358")["v_crit_kmh"], 1e-6, "table Hopf")
+        close(look["unstable_cycle_amplitude_m"], 8.2e-3, look["error_amp_m"] + 0.05e-3, "edge at 420 km/h")
+        assert look["origin_stable"] and look["stable_cycle_amplitude_m"] > look["unstable_cycle_amplitude_m"]
+        below = run_json("table-lookup", "--table", tbl, "--conicity", "0.1358", "--v", "200")
+        assert below["unstable_cycle_amplitude_m"] is None, below  # no cycle below ~239.5 km/h
+        bad = os.path.join(d, "bad.tbl")
+        with open(bad, "w") as f:
+            f.write("hunting_monitor_boundary_table 1\nkx_mn_m 8.96\n")
+        p = run("table-lookup", "--table", bad, "--conicity", "0.13", "--v", "300", ok=False)
+        assert p.returncode != 0 and "line 2: expected 'ky_mn_m'" in p.stderr, p.stderr
 
 
 def main():

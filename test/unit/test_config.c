@@ -1,4 +1,5 @@
 /* Vehicle config: the shipped file holds MODEL.md's values; every malformed config gets a located error. */
+#include <stdlib.h>
 #include <string.h>
 
 #include "hm_test.h"
@@ -138,7 +139,29 @@ static void degenerate_documents(void) {
   HM_CHECK(strstr(err, "/nonexistent/vehicle.yaml: cannot open") != NULL, "message '%s'", err);
 }
 
+/* Writing a vehicle and parsing it back gives the same doubles (17 significant digits). */
+static void format_round_trip(void) {
+  hm_vehicle v, back;
+  hm_vehicle_default(&v);
+  v.stiffness_long_n_m = 9.7e6 / 3.0; /* not representable in few digits */
+  v.conicity.terms[1].width_m = 0.00145 * (1.0 + 1e-15);
+  size_t need = 0;
+  HM_CHECK(hm_config_format_vehicle(&v, "round \"trip\"", "line one\nline two", NULL, 0, &need) == HM_EINVAL, "size");
+  char *buf = malloc(need);
+  HM_CHECK(hm_config_format_vehicle(&v, "round \"trip\"", "line one\nline two", buf, need, &need) == HM_OK, "format");
+  char name[HM_VEHICLE_NAME_MAX], err[256] = "";
+  HM_CHECK(hm_config_parse_vehicle(buf, need - 1, "rt", &back, name, err, sizeof err) == HM_OK, "parse: %s", err);
+  HM_CHECK(strcmp(name, "round trip") == 0, "name '%s'", name);
+  HM_CHECK(back.stiffness_long_n_m == v.stiffness_long_n_m || fabs(back.stiffness_long_n_m / v.stiffness_long_n_m - 1) < 1e-15,
+           "Kx %.17g vs %.17g", back.stiffness_long_n_m, v.stiffness_long_n_m);
+  HM_CHECK(back.conicity.terms[1].width_m == v.conicity.terms[1].width_m && back.mass_kg == v.mass_kg &&
+               back.flange_alpha2_n_m5 == v.flange_alpha2_n_m5 && back.conicity.n_terms == 2,
+           "fields differ after the round trip");
+  free(buf);
+}
+
 int main(void) {
+  HM_RUN(format_round_trip);
   HM_RUN(shipped_config_holds_model_values);
   HM_RUN(valid_text_parses_with_units);
   HM_RUN(malformed_configs_get_clear_errors);
