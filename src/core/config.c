@@ -9,6 +9,8 @@
 #include <string.h>
 #include <yaml.h>
 
+#include "textsink.h"
+
 typedef struct {
   yaml_document_t *doc;
   const char *source;
@@ -245,53 +247,40 @@ hm_status hm_config_load_vehicle(const char *path, hm_vehicle *veh, char *name, 
 
 /* ---- writing ---- */
 
-typedef struct {
-  char *buf;
-  size_t len, used;
-} text_sink;
-
-static void emit(text_sink *s, const char *fmt, ...) {
-  va_list ap;
-  va_start(ap, fmt);
-  char *dst = s->used < s->len ? s->buf + s->used : NULL;
-  const int n = vsnprintf(dst, dst ? s->len - s->used : 0, fmt, ap);
-  va_end(ap);
-  if (n > 0) s->used += (size_t)n;
-}
 
 hm_status hm_config_format_vehicle(const hm_vehicle *veh, const char *name, const char *comment, char *buf,
                                    size_t len, size_t *needed) {
   if (!veh || !needed || (len && !buf)) return HM_EINVAL;
-  text_sink s = {buf, len, 0};
+  hm_text_sink s = {buf, len, 0};
   for (const char *c = comment; c && *c;) { /* each comment line prefixed by '# ' */
     const char *nl = strchr(c, '\n');
     const int n = nl ? (int)(nl - c) : (int)strlen(c);
-    emit(&s, "# %.*s\n", n, c);
+    hm_text_sink_printf(&s, "# %.*s\n", n, c);
     c = nl ? nl + 1 : c + n;
   }
-  emit(&s, "vehicle:\n");
+  hm_text_sink_printf(&s, "vehicle:\n");
   if (name && *name) { /* quoted, with quotes, backslashes and control characters left out */
-    emit(&s, "  name: \"");
+    hm_text_sink_printf(&s, "  name: \"");
     for (const char *c = name; *c; ++c)
-      if (*c != '"' && *c != '\\' && (unsigned char)*c >= 0x20) emit(&s, "%c", *c);
-    emit(&s, "\"\n");
+      if (*c != '"' && *c != '\\' && (unsigned char)*c >= 0x20) hm_text_sink_printf(&s, "%c", *c);
+    hm_text_sink_printf(&s, "\"\n");
   }
-  emit(&s, "  mass_kg: %.17g\n", veh->mass_kg);
-  emit(&s, "  yaw_inertia_kg_m2: %.17g\n", veh->yaw_inertia_kg_m2);
-  emit(&s, "  contact_half_distance_m: %.17g\n", veh->contact_half_distance_m);
-  emit(&s, "  spring_half_distance_m: %.17g\n", veh->spring_half_distance_m);
-  emit(&s, "  rolling_radius_m: %.17g\n", veh->rolling_radius_m);
-  emit(&s, "  creep_long_n: %.17g\n", veh->creep_long_n);
-  emit(&s, "  creep_lat_n: %.17g\n", veh->creep_lat_n);
-  emit(&s, "  spring_ratio: %.17g\n", veh->spring_ratio);
-  emit(&s, "  kx_mn_m: %.17g\n", veh->stiffness_long_n_m * 1e-6);
-  emit(&s, "  ky_mn_m: %.17g\n", veh->stiffness_lat_n_m * 1e-6);
-  emit(&s, "conicity:\n  constant: %.17g\n  gaussians:%s\n", veh->conicity.constant,
+  hm_text_sink_printf(&s, "  mass_kg: %.17g\n", veh->mass_kg);
+  hm_text_sink_printf(&s, "  yaw_inertia_kg_m2: %.17g\n", veh->yaw_inertia_kg_m2);
+  hm_text_sink_printf(&s, "  contact_half_distance_m: %.17g\n", veh->contact_half_distance_m);
+  hm_text_sink_printf(&s, "  spring_half_distance_m: %.17g\n", veh->spring_half_distance_m);
+  hm_text_sink_printf(&s, "  rolling_radius_m: %.17g\n", veh->rolling_radius_m);
+  hm_text_sink_printf(&s, "  creep_long_n: %.17g\n", veh->creep_long_n);
+  hm_text_sink_printf(&s, "  creep_lat_n: %.17g\n", veh->creep_lat_n);
+  hm_text_sink_printf(&s, "  spring_ratio: %.17g\n", veh->spring_ratio);
+  hm_text_sink_printf(&s, "  kx_mn_m: %.17g\n", veh->stiffness_long_n_m * 1e-6);
+  hm_text_sink_printf(&s, "  ky_mn_m: %.17g\n", veh->stiffness_lat_n_m * 1e-6);
+  hm_text_sink_printf(&s, "conicity:\n  constant: %.17g\n  gaussians:%s\n", veh->conicity.constant,
        veh->conicity.n_terms ? "" : " []");
   for (size_t i = 0; i < veh->conicity.n_terms; ++i)
-    emit(&s, "    - {amplitude: %.17g, center_m: %.17g, width_m: %.17g}\n", veh->conicity.terms[i].amplitude,
+    hm_text_sink_printf(&s, "    - {amplitude: %.17g, center_m: %.17g, width_m: %.17g}\n", veh->conicity.terms[i].amplitude,
          veh->conicity.terms[i].center_m, veh->conicity.terms[i].width_m);
-  emit(&s, "flange:\n  alpha1_n_m3: %.17g\n  alpha2_n_m5: %.17g\n", veh->flange_alpha1_n_m3,
+  hm_text_sink_printf(&s, "flange:\n  alpha1_n_m3: %.17g\n  alpha2_n_m5: %.17g\n", veh->flange_alpha1_n_m3,
        veh->flange_alpha2_n_m5);
   *needed = s.used + 1;
   return s.used < len ? HM_OK : HM_EINVAL;

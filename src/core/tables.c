@@ -10,6 +10,7 @@
 
 #include "hunting_monitor/cycles.h"
 #include "hunting_monitor/hopf.h"
+#include "textsink.h"
 
 typedef struct {
   double v_kmh, amp_m;
@@ -301,34 +302,21 @@ hm_status hm_table_build(const hm_vehicle *veh, const hm_table_spec *spec, hm_ta
 
 /* ---- text format ---- */
 
-typedef struct {
-  char *buf;
-  size_t len, used;
-} sink;
-
-static void put(sink *s, const char *fmt, ...) {
-  va_list ap;
-  va_start(ap, fmt);
-  char *dst = s->used < s->len ? s->buf + s->used : NULL;
-  const int n = vsnprintf(dst, dst ? s->len - s->used : 0, fmt, ap);
-  va_end(ap);
-  if (n > 0) s->used += (size_t)n;
-}
 
 hm_status hm_table_format(const hm_table t, char *buf, size_t len, size_t *needed) {
   if (!t || !needed || (len && !buf)) return HM_EINVAL;
-  sink s = {buf, len, 0};
-  put(&s, "hunting_monitor_boundary_table 1\n");
-  put(&s, "# lambda(0) grid, Hopf speed, l1, lowest speed with a cycle; then the cycle family (v_kmh amplitude_m stable)\n");
-  put(&s, "kx_mn_m %.10g ky_mn_m %.10g speed_min_kmh %.10g speed_max_kmh %.10g amp_max_m %.10g\n", t->kx_mn_m,
+  hm_text_sink s = {buf, len, 0};
+  hm_text_sink_printf(&s, "hunting_monitor_boundary_table 1\n");
+  hm_text_sink_printf(&s, "# lambda(0) grid, Hopf speed, l1, lowest speed with a cycle; then the cycle family (v_kmh amplitude_m stable)\n");
+  hm_text_sink_printf(&s, "kx_mn_m %.10g ky_mn_m %.10g speed_min_kmh %.10g speed_max_kmh %.10g amp_max_m %.10g\n", t->kx_mn_m,
       t->ky_mn_m, t->speed_min_kmh, t->speed_max_kmh, t->amp_max_m);
-  put(&s, "error_hopf_kmh %.6g error_lowest_kmh %.6g error_edge_amp_m %.6g\n", t->err_hopf_kmh, t->err_lowest_kmh,
+  hm_text_sink_printf(&s, "error_hopf_kmh %.6g error_lowest_kmh %.6g error_edge_amp_m %.6g\n", t->err_hopf_kmh, t->err_lowest_kmh,
       t->err_amp_m);
   for (size_t i = 0; i < t->n; ++i) {
     const tcurve *c = &t->curves[i];
-    put(&s, "conicity %.10g hopf_kmh %.10g l1 %.10g lowest_kmh %.10g n %zu\n", c->conicity, c->hopf_kmh, c->l1,
+    hm_text_sink_printf(&s, "conicity %.10g hopf_kmh %.10g l1 %.10g lowest_kmh %.10g n %zu\n", c->conicity, c->hopf_kmh, c->l1,
         c->lowest_kmh, c->n);
-    for (size_t k = 0; k < c->n; ++k) put(&s, "%.9g %.7g %d\n", c->pts[k].v_kmh, c->pts[k].amp_m, c->pts[k].stable);
+    for (size_t k = 0; k < c->n; ++k) hm_text_sink_printf(&s, "%.9g %.7g %d\n", c->pts[k].v_kmh, c->pts[k].amp_m, c->pts[k].stable);
   }
   *needed = s.used + 1;
   return s.used < len ? HM_OK : HM_EINVAL;
