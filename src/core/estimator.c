@@ -1,0 +1,455 @@
+/* Streaming estimator of the dominant lateral oscillation, the standard criteria and the conicity
+ * (see estimator.h). No allocation after create. */
+#include "hunting_monitor/estimator.h"
+
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "hunting_monitor/linear.h"
+
+/* ---- biquads (RBJ cookbook = bilinear transform pre-warped at the corner) ---- */
+
+typedef struct {
+  double b0, b1, b2, a1, a2, z1, z2;
+} biquad;
+
+static biquad biquad_design(int highpass, double f0, double q, double fs) {
+  const double w0 = 2.0 * HM_PI * f0 / fs, cw = cos(w0), alpha = sin(w0) / (2.0 * q), a0 = 1.0 + alpha;
+  biquad b;
+  memset(&b, 0, sizeof b);
+  b.b0 = (highpass ? (1.0 + cw) : (1.0 - cw)) / 2.0 / a0;
+  b.b1 = (highpass ? -(1.0 + cw) : (1.0 - cw)) / a0;
+  b.b2 = b.b0;
+  b.a1 = -2.0 * cw / a0;
+  b.a2 = (1.0 - alpha) / a0;
+  return b;
+}
+
+static inline double biquad_step(biquad *f, double x) {
+  const double y = f->b0 * x + f->z1;
+  f->z1 = f->b1 * x - f->a1 * y + f->z2;
+  f->z2 = f->b2 * x - f->a2 * y;
+  return y;
+}
+
+/* |H(e^{i theta})| of a biquad at theta = 2 pi f / fs. */
+static double biquad_gain(const biquad *f, double theta) {
+  const double c1 = cos(theta), s1 = sin(theta), c2 = cos(2.0 * theta), s2 = sin(2.0 * theta);
+  const double nr = f->b0 + f->b1 * c1 + f->b2 * c2, ni = -(f->b1 * s1 + f->b2 * s2);
+  const double dr = 1.0 + f->a1 * c1 + f->a2 * c2, di = -(f->a1 * s1 + f->a2 * s2);
+  return sqrt((nr * nr + ni * ni) / (dr * dr + di * di));
+}
+
+/* Butterworth Q factors: order 4 = two sections, order 2 = one. */
+static const double Q4[2] = {0.54119610014619698, 1.3065629648763766};
+static const double Q2 = 0.70710678118654752;
+
+enum { BAND_SECTIONS = 4, PEAK_SECTIONS = 3 };
+
+struct hm_estimator_s {
+  hm_estimator_config cfg;
+  hm_linear_coef coef;           /* of the vehicle, for the conicity inversion */
+  biquad band[BAND_SECTIONS];    /* HP4 + LP4 */
+  biquad peak[PEAK_SECTIONS];    /* HP2 + LP4 */
+  /* sample history */
+  int have_sample;
+  double t_last, t_start;        /* last accepted sample, start of the current run (after a gap) */
+  double x_prev;                 /* previous band-passed value */
+  double ms;                     /* mean square of the band-passed signal */
+  /* zero crossings: a ring of up-crossing times */
+  double *cross;
+  size_t cross_cap, cross_head, cross_n;
+  int armed;
+  /* sliding r.m.s. over distance: ring of (x^2, metres) */
+  double *sq, *dist;
+  size_t ring_cap, ring_head, ring_n, since_resum;
+  double ring_sum, ring_dist;
+  /* peaks */
+  double p_prev, half_peak;
+  unsigned consecutive;
+  /* speed */
+  int have_speed;
+  double speed_kmh, t_speed;
+  /* conicity */
+  double sigma;                  /* last root real part of the inversion */
+  double conicity, conicity_conf;
+  int conicity_ok;
+  hm_estimate counters;          /* only the counters are used */
+};
+
+void hm_estimator_config_default(hm_estimator_config *c) {
+  c->sample_rate_hz = 2000.0;
+  c->band_low_hz = 2.0;
+  c->band_high_hz = 20.0;
+  c->tracking_time_s = 1.0;
+  c->rms_window_m = 100.0;
+  c->rms_limit_mps2 = 5.2;
+  c->peaks_band_low_hz = 0.5;
+  c->peaks_band_high_hz = 10.0;
+  c->peaks_limit_mps2 = 8.0;
+  c->peaks_count = 6;
+  c->conicity_min_speed_kmh = 100.0;
+  c->conicity_min_amplitude_mps2 = 0.3;
+  c->conicity_max_spread = 0.05;
+  c->conicity_min = 0.01;
+  c->conicity_max = 1.0;
+  c->max_gap_s = 0.05;
+  c->accel_timeout_s = 0.2;
+  c->speed_timeout_s = 1.0;
+  c->max_speed_kmh = 600.0;
+  c->max_speed_rate_kmh_s = 30.0;
+  c->max_accel_mps2 = 500.0;
+}
+
+static hm_status bad(char *why, size_t len, const char *field, const char *reason, double got) {
+  if (why && len) snprintf(why, len, "%s: %s (got %g)", field, reason, got);
+  return HM_EDOMAIN;
+}
+
+hm_status hm_estimator_config_validate(const hm_estimator_config *c, char *why, size_t len) {
+  if (!c) return HM_EINVAL;
+  const double fs = c->sample_rate_hz;
+  const struct {
+    const char *name;
+    double v;
+  } positive[] = {{"sample_rate_hz", fs},
+                  {"band_low_hz", c->band_low_hz},
+                  {"tracking_time_s", c->tracking_time_s},
+                  {"rms_window_m", c->rms_window_m},
+                  {"rms_limit_mps2", c->rms_limit_mps2},
+                  {"peaks_band_low_hz", c->peaks_band_low_hz},
+                  {"peaks_limit_mps2", c->peaks_limit_mps2},
+                  {"conicity_min_amplitude_mps2", c->conicity_min_amplitude_mps2},
+                  {"conicity_max_spread", c->conicity_max_spread},
+                  {"conicity_min", c->conicity_min},
+                  {"max_gap_s", c->max_gap_s},
+                  {"accel_timeout_s", c->accel_timeout_s},
+                  {"speed_timeout_s", c->speed_timeout_s},
+                  {"max_speed_kmh", c->max_speed_kmh},
+                  {"max_speed_rate_kmh_s", c->max_speed_rate_kmh_s},
+                  {"max_accel_mps2", c->max_accel_mps2}};
+  for (size_t i = 0; i < sizeof positive / sizeof positive[0]; ++i)
+    if (!isfinite(positive[i].v) || positive[i].v <= 0.0)
+      return bad(why, len, positive[i].name, "must be finite and > 0", positive[i].v);
+  if (fs < 100.0 || fs > 5000.0) return bad(why, len, "sample_rate_hz", "must be in 100..5000", fs);
+  if (!(c->band_high_hz > c->band_low_hz) || !(c->band_high_hz < 0.45 * fs))
+    return bad(why, len, "band_high_hz", "must be above band_low_hz and below 0.45 sample_rate_hz", c->band_high_hz);
+  if (!(c->peaks_band_high_hz > c->peaks_band_low_hz) || !(c->peaks_band_high_hz < 0.45 * fs))
+    return bad(why, len, "peaks_band_high_hz", "must be above peaks_band_low_hz and below 0.45 sample_rate_hz",
+               c->peaks_band_high_hz);
+  if (c->tracking_time_s * c->band_low_hz < 1.0)
+    return bad(why, len, "tracking_time_s", "must hold at least one period of band_low_hz", c->tracking_time_s);
+  if (c->peaks_count < 1 || c->peaks_count > 1000) return bad(why, len, "peaks_count", "must be 1..1000", c->peaks_count);
+  if (!isfinite(c->conicity_min_speed_kmh) || c->conicity_min_speed_kmh < 0.0)
+    return bad(why, len, "conicity_min_speed_kmh", "must be finite and >= 0", c->conicity_min_speed_kmh);
+  if (!(c->conicity_max > c->conicity_min) || !isfinite(c->conicity_max))
+    return bad(why, len, "conicity_max", "must be finite and above conicity_min", c->conicity_max);
+  if (c->max_gap_s < 2.0 / fs) return bad(why, len, "max_gap_s", "must be at least two sample periods", c->max_gap_s);
+  return HM_OK;
+}
+
+/* Filters, trackers and the r.m.s. window restart (after a gap or at reset); speed and counters stay. */
+static void restart_signal(hm_estimator e) {
+  const hm_estimator_config *c = &e->cfg;
+  const double fs = c->sample_rate_hz;
+  e->band[0] = biquad_design(1, c->band_low_hz, Q4[0], fs);
+  e->band[1] = biquad_design(1, c->band_low_hz, Q4[1], fs);
+  e->band[2] = biquad_design(0, c->band_high_hz, Q4[0], fs);
+  e->band[3] = biquad_design(0, c->band_high_hz, Q4[1], fs);
+  e->peak[0] = biquad_design(1, c->peaks_band_low_hz, Q2, fs);
+  e->peak[1] = biquad_design(0, c->peaks_band_high_hz, Q4[0], fs);
+  e->peak[2] = biquad_design(0, c->peaks_band_high_hz, Q4[1], fs);
+  e->have_sample = 0;
+  e->x_prev = 0.0;
+  e->ms = 0.0;
+  e->cross_head = e->cross_n = 0;
+  e->armed = 0;
+  e->ring_head = e->ring_n = e->since_resum = 0;
+  e->ring_sum = e->ring_dist = 0.0;
+  e->p_prev = 0.0;
+  e->half_peak = 0.0;
+  e->consecutive = 0;
+}
+
+hm_estimator hm_estimator_create(const hm_estimator_config *cfg, const hm_vehicle *veh) {
+  if (!cfg || !veh || hm_estimator_config_validate(cfg, NULL, 0) != HM_OK ||
+      hm_vehicle_validate(veh, NULL, 0) != HM_OK)
+    return NULL;
+  hm_estimator e = calloc(1, sizeof *e);
+  if (!e) return NULL;
+  e->cfg = *cfg;
+  hm_linear_coef_from_vehicle(veh, &e->coef);
+  /* crossings in one tracking time at the top of the band, with room to spare */
+  e->cross_cap = (size_t)ceil(cfg->band_high_hz * cfg->tracking_time_s * 2.0) + 8;
+  /* the r.m.s. window holds rms_window_m down to 30 km/h (and at least one second) */
+  e->ring_cap = (size_t)ceil(cfg->sample_rate_hz * fmax(cfg->rms_window_m / (30.0 / 3.6), 1.0)) + 1;
+  e->cross = malloc(e->cross_cap * sizeof(double));
+  e->sq = malloc(e->ring_cap * sizeof(double));
+  e->dist = malloc(e->ring_cap * sizeof(double));
+  if (!e->cross || !e->sq || !e->dist) {
+    hm_estimator_destroy(e);
+    return NULL;
+  }
+  hm_estimator_reset(e);
+  return e;
+}
+
+void hm_estimator_destroy(hm_estimator e) {
+  if (!e) return;
+  free(e->cross);
+  free(e->sq);
+  free(e->dist);
+  free(e);
+}
+
+void hm_estimator_reset(hm_estimator e) {
+  if (!e) return;
+  restart_signal(e);
+  e->have_speed = 0;
+  e->speed_kmh = 0.0;
+  e->t_speed = 0.0;
+  e->sigma = 0.0;
+  e->conicity = 0.0;
+  e->conicity_conf = 0.0;
+  e->conicity_ok = 0;
+  memset(&e->counters, 0, sizeof e->counters);
+}
+
+/* ---- the tracker ---- */
+
+/* Amplitude of the oscillation at frequency f: sqrt(2 mean square) corrected for the band-pass filter's gain
+ * there (a 4th-order Butterworth at 20 Hz already attenuates 15 Hz by 3%); uncorrected if f is unknown. */
+static double amplitude_at(const hm_estimator e, double f) {
+  double gain = 1.0;
+  if (f > 0.0)
+    for (int k = 0; k < BAND_SECTIONS; ++k) gain *= biquad_gain(&e->band[k], 2.0 * HM_PI * f / e->cfg.sample_rate_hz);
+  return sqrt(2.0 * e->ms) / fmax(gain, 1e-3);
+}
+
+static double amplitude(const hm_estimator e) { return amplitude_at(e, 0.0); }
+
+/* Frequency from the up-crossings within the last tracking time, and the periods' relative spread. */
+static double crossing_frequency(const hm_estimator e, double *spread) {
+  const size_t cap = e->cross_cap;
+  if (e->cross_n < 3) {
+    *spread = 1.0;
+    return 0.0;
+  }
+  const double t_last = e->cross[(e->cross_head + cap - 1) % cap];
+  size_t first = e->cross_n; /* index (0 = oldest) of the first crossing inside the window */
+  for (size_t k = 0; k < e->cross_n; ++k)
+    if (e->cross[(e->cross_head + cap - e->cross_n + k) % cap] >= t_last - e->cfg.tracking_time_s) {
+      first = k;
+      break;
+    }
+  const size_t m = e->cross_n - first;
+  if (m < 3) {
+    *spread = 1.0;
+    return 0.0;
+  }
+  const double t_first = e->cross[(e->cross_head + cap - e->cross_n + first) % cap];
+  const double mean = (t_last - t_first) / (double)(m - 1);
+  double var = 0.0;
+  for (size_t k = first + 1; k < e->cross_n; ++k) {
+    const double d = e->cross[(e->cross_head + cap - e->cross_n + k) % cap] -
+                     e->cross[(e->cross_head + cap - e->cross_n + k - 1) % cap] - mean;
+    var += d * d;
+  }
+  *spread = sqrt(var / (double)(m - 1)) / mean;
+  return 1.0 / mean;
+}
+
+/* lambda from (speed, frequency) through the linear hunting mode (see the header); 0 if it fails. */
+static int invert_conicity(hm_estimator e, double speed_kmh, double f_hz, double *lambda) {
+  const hm_linear_coef *c = &e->coef;
+  const double v = hm_mps_from_kmh(speed_kmh), w = 2.0 * HM_PI * f_hz;
+  const double c1 = c->c_lat_m_s2 / v, c2 = c->c_yaw_m_s2 / v, ge = c->c_lat_m_s2 * c->e_yaw_m_s2;
+  double sigma = isfinite(e->sigma) && fabs(e->sigma) < 1e3 ? e->sigma : 0.0;
+  for (int it = 0; it < 40; ++it) {
+    /* P1 = s^2 + c1 s + a, P2 = s^2 + c2 s + b at s = sigma + i w; q = P1 P2, q' = P1' P2 + P1 P2' */
+    const double sr = sigma, si = w, s2r = sr * sr - si * si, s2i = 2.0 * sr * si;
+    const double p1r = s2r + c1 * sr + c->k_lat_s2, p1i = s2i + c1 * si;
+    const double p2r = s2r + c2 * sr + c->k_yaw_s2, p2i = s2i + c2 * si;
+    const double d1r = 2.0 * sr + c1, d1i = 2.0 * si, d2r = 2.0 * sr + c2, d2i = 2.0 * si;
+    const double qr = p1r * p2r - p1i * p2i, qi = p1r * p2i + p1i * p2r;
+    const double dqi = (d1r * p2i + d1i * p2r) + (p1r * d2i + p1i * d2r);
+    if (dqi == 0.0 || !isfinite(dqi)) return 0;
+    const double step = qi / dqi;
+    sigma -= step;
+    if (fabs(step) <= 1e-12 * (1.0 + fabs(sigma))) {
+      const double l = -qr / ge;
+      if (!isfinite(l)) return 0;
+      e->sigma = sigma;
+      *lambda = l;
+      return 1;
+    }
+  }
+  return 0;
+}
+
+static void update_conicity(hm_estimator e, double t) {
+  const hm_estimator_config *c = &e->cfg;
+  double spread;
+  const double f = crossing_frequency(e, &spread);
+  const int speed_ok = e->have_speed && t - e->t_speed <= c->speed_timeout_s &&
+                       e->speed_kmh >= c->conicity_min_speed_kmh && e->speed_kmh > 0.0;
+  const double a = amplitude_at(e, f);
+  double lambda = 0.0;
+  const int settled = t - e->t_start >= c->tracking_time_s;
+  if (!(settled && speed_ok && f > 0.0 && a >= c->conicity_min_amplitude_mps2 && spread <= c->conicity_max_spread &&
+        invert_conicity(e, e->speed_kmh, f, &lambda) && lambda >= c->conicity_min && lambda <= c->conicity_max)) {
+    e->conicity_ok = 0;
+    e->conicity_conf = 0.0;
+    return;
+  }
+  /* confidence: signal strength (full at twice the minimum) times coherence (full at zero spread) */
+  const double strength = fmin(1.0, a / c->conicity_min_amplitude_mps2 - 1.0);
+  const double coherence = 1.0 - spread / c->conicity_max_spread;
+  e->conicity_conf = fmax(0.0, strength) * fmax(0.0, coherence);
+  /* smooth over about one tracking time (one update per crossing) */
+  const double k = fmin(1.0, 1.0 / (f * c->tracking_time_s));
+  e->conicity = e->conicity_ok ? e->conicity + k * (lambda - e->conicity) : lambda;
+  e->conicity_ok = 1;
+}
+
+/* sliding sum over the last rms_window_m of track */
+static void rms_push(hm_estimator e, double x2, double metres) {
+  if (e->ring_n == e->ring_cap) { /* full: drop the oldest */
+    const size_t old = (e->ring_head + e->ring_cap - e->ring_n) % e->ring_cap;
+    e->ring_sum -= e->sq[old];
+    e->ring_dist -= e->dist[old];
+    --e->ring_n;
+  }
+  e->sq[e->ring_head] = x2;
+  e->dist[e->ring_head] = metres;
+  e->ring_head = (e->ring_head + 1) % e->ring_cap;
+  ++e->ring_n;
+  e->ring_sum += x2;
+  e->ring_dist += metres;
+  while (e->ring_n > 1) { /* keep just enough samples to cover the window */
+    const size_t old = (e->ring_head + e->ring_cap - e->ring_n) % e->ring_cap;
+    if (e->ring_dist - e->dist[old] < e->cfg.rms_window_m) break;
+    e->ring_sum -= e->sq[old];
+    e->ring_dist -= e->dist[old];
+    --e->ring_n;
+  }
+  if (++e->since_resum >= e->ring_cap) { /* bound the rounding drift of the running sums */
+    e->ring_sum = e->ring_dist = 0.0;
+    for (size_t k = 0; k < e->ring_n; ++k) {
+      const size_t i = (e->ring_head + e->ring_cap - e->ring_n + k) % e->ring_cap;
+      e->ring_sum += e->sq[i];
+      e->ring_dist += e->dist[i];
+    }
+    e->since_resum = 0;
+  }
+}
+
+static void peaks_push(hm_estimator e, double p) {
+  if ((p >= 0.0) != (e->p_prev >= 0.0)) { /* a half cycle ended */
+    if (e->half_peak >= e->cfg.peaks_limit_mps2)
+      ++e->consecutive;
+    else
+      e->consecutive = 0;
+    e->half_peak = 0.0;
+  }
+  e->half_peak = fmax(e->half_peak, fabs(p));
+  e->p_prev = p;
+}
+
+hm_status hm_estimator_push_accel(hm_estimator e, double t, double a) {
+  if (!e) return HM_EINVAL;
+  if (!isfinite(t) || !isfinite(a)) {
+    e->counters.n_rejected_nonfinite++;
+    return HM_EDOMAIN;
+  }
+  if (fabs(a) > e->cfg.max_accel_mps2) {
+    e->counters.n_rejected_range++;
+    return HM_EDOMAIN;
+  }
+  if (e->have_sample && t <= e->t_last) {
+    e->counters.n_rejected_order++;
+    return HM_EINVAL;
+  }
+  if (e->have_sample && t - e->t_last > e->cfg.max_gap_s) {
+    e->counters.n_gaps++;
+    restart_signal(e);
+  }
+  const double dt = e->have_sample ? t - e->t_last : 1.0 / e->cfg.sample_rate_hz;
+  if (!e->have_sample) e->t_start = t;
+  e->have_sample = 1;
+  e->t_last = t;
+  e->counters.n_samples++;
+  double x = a;
+  for (int k = 0; k < BAND_SECTIONS; ++k) x = biquad_step(&e->band[k], x);
+  double p = a;
+  for (int k = 0; k < PEAK_SECTIONS; ++k) p = biquad_step(&e->peak[k], p);
+  /* mean square with time constant tracking_time / 2 */
+  e->ms += (1.0 - exp(-dt / (0.5 * e->cfg.tracking_time_s))) * (x * x - e->ms);
+  /* up-crossings, armed once the signal went below -10% of the amplitude */
+  const double h = fmax(0.1 * amplitude(e), 1e-9);
+  if (x < -h) e->armed = 1;
+  if (e->armed && e->x_prev < 0.0 && x >= 0.0) {
+    const double tc = t - dt * x / (x - e->x_prev);
+    e->cross[e->cross_head] = tc;
+    e->cross_head = (e->cross_head + 1) % e->cross_cap;
+    if (e->cross_n < e->cross_cap) ++e->cross_n;
+    e->armed = 0;
+    update_conicity(e, t);
+  }
+  e->x_prev = x;
+  const int speed_ok = e->have_speed && t - e->t_speed <= e->cfg.speed_timeout_s;
+  rms_push(e, x * x, speed_ok ? hm_mps_from_kmh(e->speed_kmh) * dt : 0.0);
+  peaks_push(e, p);
+  return HM_OK;
+}
+
+hm_status hm_estimator_push_speed(hm_estimator e, double t, double v) {
+  if (!e) return HM_EINVAL;
+  e->counters.n_speed_updates++;
+  const hm_estimator_config *c = &e->cfg;
+  int ok = isfinite(t) && isfinite(v) && v >= 0.0 && v <= c->max_speed_kmh;
+  if (ok && e->have_speed) {
+    const double dt = t - e->t_speed;
+    const int fresh = dt <= c->speed_timeout_s;
+    ok = dt > 0.0 && (!fresh || fabs(v - e->speed_kmh) <= c->max_speed_rate_kmh_s * dt + 1e-9);
+  }
+  if (!ok) {
+    e->counters.n_speed_rejected++;
+    return HM_EDOMAIN;
+  }
+  e->have_speed = 1;
+  e->speed_kmh = v;
+  e->t_speed = t;
+  return HM_OK;
+}
+
+void hm_estimator_read(const hm_estimator e, double now, hm_estimate *out) {
+  if (!e || !out) return;
+  const hm_estimator_config *c = &e->cfg;
+  hm_estimate r = e->counters;
+  r.time_s = e->have_sample ? e->t_last : 0.0;
+  r.accel_valid = e->have_sample && isfinite(now) && now - e->t_last <= c->accel_timeout_s && now >= e->t_last - 1.0;
+  r.speed_valid = e->have_speed && isfinite(now) && now - e->t_speed <= c->speed_timeout_s;
+  r.speed_kmh = e->have_speed ? e->speed_kmh : 0.0;
+  double spread = 1.0;
+  const double f = e->have_sample ? crossing_frequency(e, &spread) : 0.0;
+  const int settled = e->have_sample && e->t_last - e->t_start >= c->tracking_time_s;
+  r.oscillation_valid = settled && f > 0.0;
+  r.amplitude_accel_mps2 = e->have_sample ? amplitude_at(e, r.oscillation_valid ? f : 0.0) : 0.0;
+  r.frequency_hz = r.oscillation_valid ? f : 0.0;
+  r.period_spread = r.oscillation_valid ? spread : 1.0;
+  const double w = 2.0 * HM_PI * r.frequency_hz;
+  r.amplitude_displacement_m = r.oscillation_valid ? r.amplitude_accel_mps2 / (w * w) : 0.0;
+  r.rms_mps2 = e->ring_n ? sqrt(fmax(e->ring_sum, 0.0) / (double)e->ring_n) : 0.0;
+  r.rms_window_complete = e->ring_dist >= c->rms_window_m * (1.0 - 1e-9) ||
+                          (e->ring_n > 1 && e->ring_dist + 1e-12 >= c->rms_window_m);
+  r.rms_exceeded = r.rms_window_complete && r.rms_mps2 >= c->rms_limit_mps2;
+  r.consecutive_peaks = e->consecutive;
+  r.peaks_exceeded = e->consecutive >= c->peaks_count;
+  r.conicity_valid = e->conicity_ok && r.speed_valid && r.accel_valid;
+  r.conicity = e->conicity;
+  r.conicity_confidence = r.conicity_valid ? e->conicity_conf : 0.0;
+  *out = r;
+}
