@@ -29,6 +29,8 @@
 
 #include <stddef.h>
 
+#include "hunting_monitor/alarm.h"
+#include "hunting_monitor/estimator.h"
 #include "hunting_monitor/model.h"
 #include "hunting_monitor/status.h"
 
@@ -49,6 +51,18 @@ hm_status hm_config_parse_vehicle(const char *text, size_t len, const char *sour
 
 /* Read the file at path and parse it as above; HM_EIO if it cannot be read. */
 hm_status hm_config_load_vehicle(const char *path, hm_vehicle *veh, char *name, char *err, size_t err_len);
+
+/*
+ * Monitor settings (config/monitor.yaml): optional sections `estimator:` and `alarm:` whose keys are the field
+ * names of hm_estimator_config and hm_alarm_config (use_conicity_estimate: true/false). Fields not given keep
+ * the values *est and *alarm hold on entry (pass the defaults); unknown keys and non-numbers are errors (HM_EPARSE),
+ * then the whole configuration is validated (HM_EDOMAIN). Outputs untouched on failure. Other top-level sections
+ * (vehicle, conicity, flange) are ignored, so one file may hold both.
+ */
+hm_status hm_config_parse_monitor(const char *text, size_t len, const char *source, hm_estimator_config *est,
+                                  hm_alarm_config *alarm, char *err, size_t err_len);
+hm_status hm_config_load_monitor(const char *path, hm_estimator_config *est, hm_alarm_config *alarm, char *err,
+                                 size_t err_len);
 
 /*
  * Write veh as a complete vehicle config (the format above, values with 17 significant digits so that parsing

@@ -394,6 +394,12 @@ static const command commands[] = {
      "y_m,conicity (or y_mm,conicity with --y-unit mm): parameters with standard errors, SSE, R^2, adjusted\n"
      "R^2, RMSE, lambda(0) and the vehicle's Hopf speed with it; --write-config writes a vehicle config.",
      fit_conicity_opts, cmd_fit_conicity},
+    {"estimate", "run the online monitor over recorded acceleration and speed",
+     "--accel FILE.csv (--speed FILE.csv | --v KM/H) [--table FILE] [--monitor FILE] [--every S]",
+     "Run exactly the online estimator and alarm code over recorded data (CSV t_s,accel_mps2 and t_s,speed_kmh)\n"
+     "and print one JSON object per output interval: amplitude, frequency, conicity estimate, margins,\n"
+     "criteria, level and reason.",
+     estimate_opts, cmd_estimate},
     {"sweep", "linear critical speed over a conicity range", "[--from L --to L --n COUNT] [--table]",
      "Linear critical speed over a range of equivalent conicities (JSON, or a table with --table).", sweep_opts,
      cmd_sweep},

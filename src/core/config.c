@@ -2,6 +2,7 @@
 #include "hunting_monitor/config.h"
 
 #include <errno.h>
+#include <stddef.h>
 #include <math.h>
 #include <stdarg.h>
 #include <stdio.h>
@@ -220,27 +221,159 @@ hm_status hm_config_parse_vehicle(const char *text, size_t len, const char *sour
   return HM_OK;
 }
 
-hm_status hm_config_load_vehicle(const char *path, hm_vehicle *veh, char *name, char *err, size_t err_len) {
-  parse_ctx c = {NULL, path ? path : "<null>", err, err_len};
-  if (!path) return fail(&c, NULL, HM_EINVAL, "no path");
+/* Read a whole (small) file into a malloc'd buffer. */
+static hm_status read_small_file(parse_ctx *c, const char *path, char **text, size_t *len) {
   FILE *f = fopen(path, "rb");
-  if (!f) return fail(&c, NULL, HM_EIO, "cannot open: %s", strerror(errno));
+  if (!f) return fail(c, NULL, HM_EIO, "cannot open: %s", strerror(errno));
   enum { MAX_CONFIG_BYTES = 1 << 20 };
   char *buf = malloc(MAX_CONFIG_BYTES + 1);
   if (!buf) {
     fclose(f);
-    return fail(&c, NULL, HM_ENOMEM, "out of memory");
+    return fail(c, NULL, HM_ENOMEM, "out of memory");
   }
   const size_t n = fread(buf, 1, MAX_CONFIG_BYTES + 1, f);
   const int read_error = ferror(f);
   fclose(f);
-  hm_status st;
+  hm_status st = HM_OK;
   if (read_error)
-    st = fail(&c, NULL, HM_EIO, "read error");
+    st = fail(c, NULL, HM_EIO, "read error");
   else if (n > MAX_CONFIG_BYTES)
-    st = fail(&c, NULL, HM_EPARSE, "larger than 1 MiB: not a vehicle config");
-  else
-    st = hm_config_parse_vehicle(buf, n, path, veh, name, err, err_len);
+    st = fail(c, NULL, HM_EPARSE, "larger than 1 MiB: not a config file");
+  if (st != HM_OK) {
+    free(buf);
+    return st;
+  }
+  *text = buf;
+  *len = n;
+  return HM_OK;
+}
+
+hm_status hm_config_load_vehicle(const char *path, hm_vehicle *veh, char *name, char *err, size_t err_len) {
+  parse_ctx c = {NULL, path ? path : "<null>", err, err_len};
+  if (!path) return fail(&c, NULL, HM_EINVAL, "no path");
+  char *buf = NULL;
+  size_t n = 0;
+  hm_status st = read_small_file(&c, path, &buf, &n);
+  if (st != HM_OK) return st;
+  st = hm_config_parse_vehicle(buf, n, path, veh, name, err, err_len);
+  free(buf);
+  return st;
+}
+
+/* ---- monitor settings ---- */
+
+typedef enum { FIELD_DOUBLE, FIELD_UNSIGNED, FIELD_BOOL } field_type;
+
+typedef struct {
+  const char *key;
+  field_type type;
+  size_t offset;
+} settings_field;
+
+#define EST(f, t) {#f, t, offsetof(hm_estimator_config, f)}
+#define ALM(f, t) {#f, t, offsetof(hm_alarm_config, f)}
+
+static const settings_field estimator_fields[] = {
+    EST(sample_rate_hz, FIELD_DOUBLE),       EST(band_low_hz, FIELD_DOUBLE),
+    EST(band_high_hz, FIELD_DOUBLE),         EST(tracking_time_s, FIELD_DOUBLE),
+    EST(rms_window_m, FIELD_DOUBLE),         EST(rms_limit_mps2, FIELD_DOUBLE),
+    EST(peaks_band_low_hz, FIELD_DOUBLE),    EST(peaks_band_high_hz, FIELD_DOUBLE),
+    EST(peaks_limit_mps2, FIELD_DOUBLE),     EST(peaks_count, FIELD_UNSIGNED),
+    EST(conicity_min_speed_kmh, FIELD_DOUBLE), EST(conicity_min_amplitude_mps2, FIELD_DOUBLE),
+    EST(conicity_max_spread, FIELD_DOUBLE),  EST(conicity_min, FIELD_DOUBLE),
+    EST(conicity_max, FIELD_DOUBLE),         EST(max_gap_s, FIELD_DOUBLE),
+    EST(accel_timeout_s, FIELD_DOUBLE),      EST(speed_timeout_s, FIELD_DOUBLE),
+    EST(max_speed_kmh, FIELD_DOUBLE),        EST(max_speed_rate_kmh_s, FIELD_DOUBLE),
+    EST(max_accel_mps2, FIELD_DOUBLE),
+};
+
+static const settings_field alarm_fields[] = {
+    ALM(warn_amplitude_fraction, FIELD_DOUBLE), ALM(warn_speed_margin_kmh, FIELD_DOUBLE),
+    ALM(hysteresis_kmh, FIELD_DOUBLE),          ALM(hysteresis_amplitude_fraction, FIELD_DOUBLE),
+    ALM(min_hold_s, FIELD_DOUBLE),              ALM(use_conicity_estimate, FIELD_BOOL),
+    ALM(conicity_min_confidence, FIELD_DOUBLE), ALM(conicity_fallback, FIELD_DOUBLE),
+};
+
+/* Apply the keys of one section onto the struct at base. */
+static hm_status apply_section(parse_ctx *c, yaml_node_t *sec, const char *name, const settings_field *fields,
+                               size_t n_fields, void *base) {
+  if (sec->type != YAML_MAPPING_NODE) return fail(c, sec, HM_EPARSE, "%s: expected a mapping of keys", name);
+  for (yaml_node_pair_t *p = sec->data.mapping.pairs.start; p < sec->data.mapping.pairs.top; ++p) {
+    yaml_node_t *k = yaml_document_get_node(c->doc, p->key), *v = yaml_document_get_node(c->doc, p->value);
+    if (!k || k->type != YAML_SCALAR_NODE || !v) return fail(c, k, HM_EPARSE, "%s: keys must be plain names", name);
+    const settings_field *f = NULL;
+    for (size_t i = 0; i < n_fields && !f; ++i)
+      if (strcmp(fields[i].key, scalar_text(k)) == 0) f = &fields[i];
+    char path[96];
+    snprintf(path, sizeof path, "%s.%s", name, scalar_text(k));
+    if (!f) return fail(c, k, HM_EPARSE, "%s: unknown key", path);
+    if (f->type == FIELD_BOOL) {
+      const char *t = v->type == YAML_SCALAR_NODE ? scalar_text(v) : "";
+      const int yes = strcmp(t, "true") == 0, no = strcmp(t, "false") == 0;
+      if (!yes && !no) return fail(c, v, HM_EPARSE, "%s: expected true or false, got '%s'", path, t);
+      *(int *)((char *)base + f->offset) = yes;
+      continue;
+    }
+    double x = 0.0;
+    hm_status st = node_number(c, v, path, &x);
+    if (st != HM_OK) return st;
+    if (f->type == FIELD_UNSIGNED) {
+      if (x < 0.0 || x > 1e9 || x != floor(x)) return fail(c, v, HM_EPARSE, "%s: expected a whole number", path);
+      *(unsigned *)((char *)base + f->offset) = (unsigned)x;
+    } else {
+      *(double *)((char *)base + f->offset) = x;
+    }
+  }
+  return HM_OK;
+}
+
+hm_status hm_config_parse_monitor(const char *text, size_t len, const char *source, hm_estimator_config *est,
+                                  hm_alarm_config *alarm, char *err, size_t err_len) {
+  if (!source) source = "<config>";
+  parse_ctx c = {NULL, source, err, err_len};
+  if (!text || !est || !alarm) return fail(&c, NULL, HM_EINVAL, "no text or no output");
+  yaml_parser_t parser;
+  yaml_document_t doc;
+  if (!yaml_parser_initialize(&parser)) return fail(&c, NULL, HM_ENOMEM, "cannot initialise the YAML parser");
+  yaml_parser_set_input_string(&parser, (const unsigned char *)text, len);
+  if (!yaml_parser_load(&parser, &doc)) {
+    hm_status st = fail(&c, NULL, HM_EPARSE, "line %lu: YAML syntax error: %s",
+                        (unsigned long)parser.problem_mark.line + 1, parser.problem ? parser.problem : "unknown");
+    yaml_parser_delete(&parser);
+    return st;
+  }
+  c.doc = &doc;
+  hm_estimator_config e = *est;
+  hm_alarm_config a = *alarm;
+  hm_status st = HM_OK;
+  yaml_node_t *root = yaml_document_get_root_node(&doc);
+  if (!root || root->type != YAML_MAPPING_NODE) st = fail(&c, root, HM_EPARSE, "expected a mapping at the top level");
+  yaml_node_t *sec;
+  if (st == HM_OK && (sec = map_get(&c, root, "estimator")))
+    st = apply_section(&c, sec, "estimator", estimator_fields, sizeof estimator_fields / sizeof estimator_fields[0], &e);
+  if (st == HM_OK && (sec = map_get(&c, root, "alarm")))
+    st = apply_section(&c, sec, "alarm", alarm_fields, sizeof alarm_fields / sizeof alarm_fields[0], &a);
+  char why[160];
+  if (st == HM_OK && (st = hm_estimator_config_validate(&e, why, sizeof why)) != HM_OK)
+    fail(&c, NULL, st, "estimator.%s", why);
+  if (st == HM_OK && (st = hm_alarm_config_validate(&a, why, sizeof why)) != HM_OK) fail(&c, NULL, st, "alarm.%s", why);
+  yaml_document_delete(&doc);
+  yaml_parser_delete(&parser);
+  if (st != HM_OK) return st;
+  *est = e;
+  *alarm = a;
+  return HM_OK;
+}
+
+hm_status hm_config_load_monitor(const char *path, hm_estimator_config *est, hm_alarm_config *alarm, char *err,
+                                 size_t err_len) {
+  parse_ctx c = {NULL, path ? path : "<null>", err, err_len};
+  if (!path) return fail(&c, NULL, HM_EINVAL, "no path");
+  char *buf = NULL;
+  size_t n = 0;
+  hm_status st = read_small_file(&c, path, &buf, &n);
+  if (st != HM_OK) return st;
+  st = hm_config_parse_monitor(buf, n, path, est, alarm, err, err_len);
   free(buf);
   return st;
 }

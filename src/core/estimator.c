@@ -58,8 +58,9 @@ struct hm_estimator_s {
   double t_last, t_start;        /* last accepted sample, start of the current run (after a gap) */
   double x_prev;                 /* previous band-passed value */
   double ms;                     /* mean square of the band-passed signal */
-  /* zero crossings: a ring of up-crossing times */
-  double *cross;
+  /* zero crossings: a ring of up-crossing times, with the running sum of x^2 and the sample count at each */
+  double *cross, *cross_sum, *cross_count;
+  double sum_sq, count;          /* running sum of x^2 and number of samples since the restart */
   size_t cross_cap, cross_head, cross_n;
   int armed;
   /* sliding r.m.s. over distance: ring of (x^2, metres) */
@@ -165,6 +166,7 @@ static void restart_signal(hm_estimator e) {
   e->x_prev = 0.0;
   e->ms = 0.0;
   e->cross_head = e->cross_n = 0;
+  e->sum_sq = e->count = 0.0;
   e->armed = 0;
   e->ring_head = e->ring_n = e->since_resum = 0;
   e->ring_sum = e->ring_dist = 0.0;
@@ -186,9 +188,11 @@ hm_estimator hm_estimator_create(const hm_estimator_config *cfg, const hm_vehicl
   /* the r.m.s. window holds rms_window_m down to 30 km/h (and at least one second) */
   e->ring_cap = (size_t)ceil(cfg->sample_rate_hz * fmax(cfg->rms_window_m / (30.0 / 3.6), 1.0)) + 1;
   e->cross = malloc(e->cross_cap * sizeof(double));
+  e->cross_sum = malloc(e->cross_cap * sizeof(double));
+  e->cross_count = malloc(e->cross_cap * sizeof(double));
   e->sq = malloc(e->ring_cap * sizeof(double));
   e->dist = malloc(e->ring_cap * sizeof(double));
-  if (!e->cross || !e->sq || !e->dist) {
+  if (!e->cross || !e->cross_sum || !e->cross_count || !e->sq || !e->dist) {
     hm_estimator_destroy(e);
     return NULL;
   }
@@ -199,6 +203,8 @@ hm_estimator hm_estimator_create(const hm_estimator_config *cfg, const hm_vehicl
 void hm_estimator_destroy(hm_estimator e) {
   if (!e) return;
   free(e->cross);
+  free(e->cross_sum);
+  free(e->cross_count);
   free(e->sq);
   free(e->dist);
   free(e);
@@ -219,19 +225,21 @@ void hm_estimator_reset(hm_estimator e) {
 
 /* ---- the tracker ---- */
 
-/* Amplitude of the oscillation at frequency f: sqrt(2 mean square) corrected for the band-pass filter's gain
- * there (a 4th-order Butterworth at 20 Hz already attenuates 15 Hz by 3%); uncorrected if f is unknown. */
-static double amplitude_at(const hm_estimator e, double f) {
+/* Amplitude of the oscillation at frequency f from mean square ms: sqrt(2 ms) corrected for the band-pass
+ * filter's gain there (a 4th-order Butterworth at 20 Hz already attenuates 15 Hz by 3%); uncorrected if f is
+ * unknown. */
+static double amplitude_from(const hm_estimator e, double ms, double f) {
   double gain = 1.0;
   if (f > 0.0)
     for (int k = 0; k < BAND_SECTIONS; ++k) gain *= biquad_gain(&e->band[k], 2.0 * HM_PI * f / e->cfg.sample_rate_hz);
-  return sqrt(2.0 * e->ms) / fmax(gain, 1e-3);
+  return sqrt(2.0 * fmax(ms, 0.0)) / fmax(gain, 1e-3);
 }
 
-static double amplitude(const hm_estimator e) { return amplitude_at(e, 0.0); }
+static double amplitude(const hm_estimator e) { return amplitude_from(e, e->ms, 0.0); }
 
-/* Frequency from the up-crossings within the last tracking time, and the periods' relative spread. */
-static double crossing_frequency(const hm_estimator e, double *spread) {
+/* Frequency from the up-crossings within the last tracking time, the periods' relative spread, and (if ms is
+ * not NULL) the mean square over those whole periods (free of the one-pole average's ripple). */
+static double crossing_frequency(const hm_estimator e, double *spread, double *ms) {
   const size_t cap = e->cross_cap;
   if (e->cross_n < 3) {
     *spread = 1.0;
@@ -258,7 +266,21 @@ static double crossing_frequency(const hm_estimator e, double *spread) {
     var += d * d;
   }
   *spread = sqrt(var / (double)(m - 1)) / mean;
+  if (ms) {
+    const size_t i_first = (e->cross_head + cap - e->cross_n + first) % cap, i_last = (e->cross_head + cap - 1) % cap;
+    const double n = e->cross_count[i_last] - e->cross_count[i_first];
+    if (n > 0.0) *ms = (e->cross_sum[i_last] - e->cross_sum[i_first]) / n;
+  }
   return 1.0 / mean;
+}
+
+/* The tracked oscillation: frequency, spread, and the amplitude over whole periods (the running one-pole
+ * mean square until there are periods to average over). */
+static double tracked(const hm_estimator e, double *spread, double *amp) {
+  double ms = e->ms;
+  const double f = crossing_frequency(e, spread, &ms);
+  *amp = amplitude_from(e, ms, f);
+  return f;
 }
 
 /* lambda from (speed, frequency) through the linear hunting mode (see the header); 0 if it fails. */
@@ -291,11 +313,10 @@ static int invert_conicity(hm_estimator e, double speed_kmh, double f_hz, double
 
 static void update_conicity(hm_estimator e, double t) {
   const hm_estimator_config *c = &e->cfg;
-  double spread;
-  const double f = crossing_frequency(e, &spread);
+  double spread, a;
+  const double f = tracked(e, &spread, &a);
   const int speed_ok = e->have_speed && t - e->t_speed <= c->speed_timeout_s &&
                        e->speed_kmh >= c->conicity_min_speed_kmh && e->speed_kmh > 0.0;
-  const double a = amplitude_at(e, f);
   double lambda = 0.0;
   const int settled = t - e->t_start >= c->tracking_time_s;
   if (!(settled && speed_ok && f > 0.0 && a >= c->conicity_min_amplitude_mps2 && spread <= c->conicity_max_spread &&
@@ -390,9 +411,13 @@ hm_status hm_estimator_push_accel(hm_estimator e, double t, double a) {
   /* up-crossings, armed once the signal went below -10% of the amplitude */
   const double h = fmax(0.1 * amplitude(e), 1e-9);
   if (x < -h) e->armed = 1;
+  e->sum_sq += x * x;
+  e->count += 1.0;
   if (e->armed && e->x_prev < 0.0 && x >= 0.0) {
     const double tc = t - dt * x / (x - e->x_prev);
     e->cross[e->cross_head] = tc;
+    e->cross_sum[e->cross_head] = e->sum_sq;
+    e->cross_count[e->cross_head] = e->count;
     e->cross_head = (e->cross_head + 1) % e->cross_cap;
     if (e->cross_n < e->cross_cap) ++e->cross_n;
     e->armed = 0;
@@ -433,11 +458,11 @@ void hm_estimator_read(const hm_estimator e, double now, hm_estimate *out) {
   r.accel_valid = e->have_sample && isfinite(now) && now - e->t_last <= c->accel_timeout_s && now >= e->t_last - 1.0;
   r.speed_valid = e->have_speed && isfinite(now) && now - e->t_speed <= c->speed_timeout_s;
   r.speed_kmh = e->have_speed ? e->speed_kmh : 0.0;
-  double spread = 1.0;
-  const double f = e->have_sample ? crossing_frequency(e, &spread) : 0.0;
+  double spread = 1.0, amp = 0.0;
+  const double f = e->have_sample ? tracked(e, &spread, &amp) : 0.0;
   const int settled = e->have_sample && e->t_last - e->t_start >= c->tracking_time_s;
   r.oscillation_valid = settled && f > 0.0;
-  r.amplitude_accel_mps2 = e->have_sample ? amplitude_at(e, r.oscillation_valid ? f : 0.0) : 0.0;
+  r.amplitude_accel_mps2 = e->have_sample ? (r.oscillation_valid ? amp : amplitude(e)) : 0.0;
   r.frequency_hz = r.oscillation_valid ? f : 0.0;
   r.period_spread = r.oscillation_valid ? spread : 1.0;
   const double w = 2.0 * HM_PI * r.frequency_hz;

@@ -160,7 +160,48 @@ static void format_round_trip(void) {
   free(buf);
 }
 
+static int same_alarm(const hm_alarm_config *x, const hm_alarm_config *y) { /* field by field: padding */
+  return x->warn_amplitude_fraction == y->warn_amplitude_fraction &&
+         x->warn_speed_margin_kmh == y->warn_speed_margin_kmh && x->hysteresis_kmh == y->hysteresis_kmh &&
+         x->hysteresis_amplitude_fraction == y->hysteresis_amplitude_fraction && x->min_hold_s == y->min_hold_s &&
+         x->use_conicity_estimate == y->use_conicity_estimate &&
+         x->conicity_min_confidence == y->conicity_min_confidence && x->conicity_fallback == y->conicity_fallback;
+}
+
+/* The shipped monitor settings are the documented defaults; errors are located. */
+static void monitor_settings(void) {
+  hm_estimator_config e, de;
+  hm_alarm_config a, da;
+  hm_estimator_config_default(&e);
+  hm_estimator_config_default(&de);
+  hm_alarm_config_default(&a);
+  hm_alarm_config_default(&da);
+  e.band_low_hz = 99.0; /* must be overwritten by the file */
+  char err[256] = "";
+  HM_CHECK(hm_config_load_monitor(HM_SOURCE_DIR "/config/monitor.yaml", &e, &a, err, sizeof err) == HM_OK, "%s", err);
+  HM_CHECK(memcmp(&e, &de, sizeof e) == 0, "config/monitor.yaml estimator section differs from the defaults");
+  HM_CHECK(same_alarm(&a, &da), "config/monitor.yaml alarm section differs from the defaults");
+  const struct {
+    const char *text, *message;
+    hm_status st;
+  } bad[] = {
+      {"estimator:\n  band_low: 2\n", "t:2: estimator.band_low: unknown key", HM_EPARSE},
+      {"alarm:\n  use_conicity_estimate: maybe\n", "alarm.use_conicity_estimate: expected true or false", HM_EPARSE},
+      {"estimator:\n  peaks_count: 6.5\n", "estimator.peaks_count: expected a whole number", HM_EPARSE},
+      {"estimator:\n  sample_rate_hz: 20\n", "estimator.sample_rate_hz: must be in 100..5000", HM_EDOMAIN},
+      {"alarm:\n  min_hold_s: -1\n", "alarm.min_hold_s: out of range", HM_EDOMAIN},
+  };
+  for (size_t i = 0; i < sizeof bad / sizeof bad[0]; ++i) {
+    hm_estimator_config e2 = de;
+    hm_alarm_config a2 = da;
+    const hm_status st = hm_config_parse_monitor(bad[i].text, strlen(bad[i].text), "t", &e2, &a2, err, sizeof err);
+    HM_CHECK(st == bad[i].st && strstr(err, bad[i].message), "case %zu: %s: '%s'", i, hm_status_str(st), err);
+    HM_CHECK(memcmp(&e2, &de, sizeof e2) == 0 && same_alarm(&a2, &da), "case %zu: output changed", i);
+  }
+}
+
 int main(void) {
+  HM_RUN(monitor_settings);
   HM_RUN(format_round_trip);
   HM_RUN(shipped_config_holds_model_values);
   HM_RUN(valid_text_parses_with_units);

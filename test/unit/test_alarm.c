@@ -1,0 +1,166 @@
+/* Alarm levels: thresholds from the boundary table, hysteresis, hold time, NO_DATA, reasons. */
+#include <string.h>
+
+#include "hm_test.h"
+#include "hunting_monitor/alarm.h"
+#include "hunting_monitor/linear.h"
+
+static hm_table table;
+
+/* A current estimate at speed v with displacement amplitude amp [m] (no criterion met, no conicity estimate). */
+static hm_estimate estimate(double v, double amp) {
+  hm_estimate e;
+  memset(&e, 0, sizeof e);
+  e.accel_valid = e.speed_valid = 1;
+  e.speed_kmh = v;
+  e.oscillation_valid = amp > 0.0;
+  e.amplitude_displacement_m = amp;
+  e.frequency_hz = amp > 0.0 ? 14.0 : 0.0;
+  return e;
+}
+
+static hm_alarm make(void) {
+  hm_alarm_config c;
+  hm_alarm_config_default(&c);
+  return hm_alarm_create(&c, table);
+}
+
+/* Levels at the default vehicle's boundaries (lambda(0) = 0.1358: Hopf 517.618 km/h (closed form), lowest
+ * cycle about 239.5 km/h, basin edge about 8.35 mm at 400 km/h - MODEL.md section 7). */
+static void levels_follow_the_boundaries(void) {
+  hm_vehicle v;
+  hm_vehicle_default(&v);
+  double vc;
+  hm_linear_critical_speed(&v, 0.1358, &vc);
+  const double hopf = hm_kmh_from_mps(vc);
+  const struct {
+    double v, amp;
+    hm_level level;
+    hm_reason reason;
+  } cases[] = {
+      {200.0, 0.0, HM_LEVEL_OK, HM_REASON_BELOW_LOWEST_CYCLE},
+      {400.0, 0.0, HM_LEVEL_WATCH, HM_REASON_BISTABLE_BAND},
+      {400.0, 0.005, HM_LEVEL_WARN, HM_REASON_AMPLITUDE_NEAR_EDGE},
+      {400.0, 0.009, HM_LEVEL_ALARM, HM_REASON_AMPLITUDE_BEYOND_EDGE},
+      {hopf - 5.0, 0.0, HM_LEVEL_WARN, HM_REASON_NEAR_HOPF},
+      {hopf + 0.5, 0.0, HM_LEVEL_ALARM, HM_REASON_ABOVE_HOPF},
+  };
+  for (size_t i = 0; i < sizeof cases / sizeof cases[0]; ++i) {
+    hm_alarm a = make();
+    hm_assessment s;
+    const hm_estimate e = estimate(cases[i].v, cases[i].amp);
+    HM_CHECK(hm_alarm_update(a, &e, 10.0, &s) == HM_OK, "update");
+    HM_CHECK(s.level == cases[i].level && s.reason == cases[i].reason, "v %g amp %g: %s (%s)", cases[i].v,
+             cases[i].amp, hm_level_name(s.level), hm_reason_text(s.reason));
+    HM_CHECK(s.boundaries_valid && s.changed, "boundaries and change flag");
+    HM_CHECK_DELTA(s.margin_hopf_kmh, hopf - cases[i].v, 1e-6, "margin to the Hopf speed");
+    hm_alarm_destroy(a);
+  }
+  hm_estimate e = estimate(300.0, 0.0);
+  e.rms_exceeded = 1;
+  hm_alarm a = make();
+  hm_assessment s;
+  hm_alarm_update(a, &e, 0.0, &s);
+  HM_CHECK(s.level == HM_LEVEL_ALARM && s.reason == HM_REASON_RMS_CRITERION, "r.m.s. criterion");
+  e.rms_exceeded = 0;
+  e.peaks_exceeded = 1;
+  hm_alarm_update(a, &e, 0.1, &s);
+  HM_CHECK(s.level == HM_LEVEL_ALARM && s.reason == HM_REASON_PEAKS_CRITERION && !s.changed, "peaks criterion");
+  hm_alarm_destroy(a);
+}
+
+/* A stale input gives NO_DATA at once, with no boundaries presented; data back gives the level at once. */
+static void stale_input_is_no_data(void) {
+  hm_alarm a = make();
+  hm_assessment s;
+  hm_estimate e = estimate(520.0, 0.0);
+  hm_alarm_update(a, &e, 0.0, &s);
+  HM_CHECK(s.level == HM_LEVEL_ALARM, "alarm");
+  e.speed_valid = 0;
+  hm_alarm_update(a, &e, 0.1, &s);
+  HM_CHECK(s.level == HM_LEVEL_NO_DATA && s.reason == HM_REASON_NO_SPEED && !s.boundaries_valid && s.changed,
+           "stale speed: %s", hm_level_name(s.level));
+  e.speed_valid = 1;
+  e.accel_valid = 0;
+  hm_alarm_update(a, &e, 0.2, &s);
+  HM_CHECK(s.level == HM_LEVEL_NO_DATA && s.reason == HM_REASON_NO_ACCEL, "stale acceleration");
+  e = estimate(200.0, 0.0);
+  hm_alarm_update(a, &e, 0.3, &s);
+  HM_CHECK(s.level == HM_LEVEL_OK && s.changed, "data back: %s", hm_level_name(s.level));
+}
+
+/* Hysteresis and hold: from ALARM (above Hopf) down to 3 km/h below it the level stays ALARM; further down it
+ * falls to WARN only after 3 s; a speed dithering around the WARN threshold changes the level once. */
+static void hysteresis_and_hold_prevent_chatter(void) {
+  hm_vehicle v;
+  hm_vehicle_default(&v);
+  double vc;
+  hm_linear_critical_speed(&v, 0.1358, &vc);
+  const double hopf = hm_kmh_from_mps(vc);
+  hm_alarm a = make();
+  hm_assessment s;
+  hm_estimate e = estimate(hopf + 1.0, 0.0);
+  hm_alarm_update(a, &e, 0.0, &s);
+  HM_CHECK(s.level == HM_LEVEL_ALARM, "alarm above Hopf");
+  e = estimate(hopf - 2.0, 0.0); /* inside the 3 km/h hysteresis */
+  for (double t = 0.1; t < 10.0; t += 0.1) {
+    hm_alarm_update(a, &e, t, &s);
+    HM_CHECK(s.level == HM_LEVEL_ALARM, "t %g: %s inside the hysteresis", t, hm_level_name(s.level));
+  }
+  e = estimate(hopf - 5.0, 0.0);
+  double changed_at = -1.0;
+  for (double t = 10.0; t < 20.0; t += 0.1) {
+    hm_alarm_update(a, &e, t, &s);
+    if (s.changed && changed_at < 0.0) changed_at = t;
+  }
+  HM_CHECK(s.level == HM_LEVEL_WARN && s.reason == HM_REASON_NEAR_HOPF, "down to WARN: %s", hm_level_name(s.level));
+  HM_CHECK_DELTA(changed_at, 13.0, 0.11, "WARN after the 3 s hold");
+  /* dither around the WARN threshold (hopf - 10 km/h) by +-0.5 km/h every 0.1 s for 20 s */
+  int changes = 0;
+  for (int k = 0; k < 200; ++k) {
+    e = estimate(hopf - 10.0 + (k % 2 ? 0.5 : -0.5), 0.0);
+    hm_alarm_update(a, &e, 20.0 + 0.1 * k, &s);
+    changes += s.changed;
+  }
+  HM_CHECK(changes == 0, "%d level changes while dithering inside the hysteresis", changes);
+  hm_alarm_destroy(a);
+}
+
+static void bad_configuration_and_input(void) {
+  hm_alarm_config c;
+  char why[128];
+  hm_alarm_config_default(&c);
+  c.warn_amplitude_fraction = 1.5;
+  HM_CHECK(hm_alarm_config_validate(&c, why, sizeof why) == HM_EDOMAIN && strstr(why, "warn_amplitude_fraction"),
+           "%s", why);
+  HM_CHECK(hm_alarm_create(&c, table) == NULL, "created with a bad configuration");
+  hm_alarm_config_default(&c);
+  c.min_hold_s = NAN;
+  HM_CHECK(hm_alarm_config_validate(&c, why, sizeof why) == HM_EDOMAIN && strstr(why, "min_hold_s"), "%s", why);
+  hm_alarm a = make();
+  hm_assessment s;
+  const hm_estimate e = estimate(300.0, 0.0);
+  HM_CHECK(hm_alarm_update(a, &e, NAN, &s) == HM_EINVAL, "NaN time");
+  HM_CHECK(hm_alarm_update(a, NULL, 1.0, &s) == HM_EINVAL, "NULL estimate");
+  hm_alarm_destroy(a);
+}
+
+int main(void) {
+  hm_vehicle v;
+  hm_vehicle_default(&v);
+  hm_table_spec spec;
+  hm_table_spec_default(&spec);
+  spec.conicity_min = 0.12;
+  spec.conicity_max = 0.16;
+  spec.n_conicity = 3;
+  if (hm_table_build(&v, &spec, &table) != HM_OK) {
+    printf("FAIL table_build\n");
+    return 1;
+  }
+  HM_RUN(levels_follow_the_boundaries);
+  HM_RUN(stale_input_is_no_data);
+  HM_RUN(hysteresis_and_hold_prevent_chatter);
+  HM_RUN(bad_configuration_and_input);
+  hm_table_destroy(table);
+  HM_TEST_EXIT();
+}

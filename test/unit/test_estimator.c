@@ -1,0 +1,304 @@
+/* Streaming estimator: synthetic signals with known amplitude/frequency, the criteria against closed forms,
+ * the conicity inversion against LAPACK eigenvalues, bad input, and a 1-hour stream without allocation. */
+#include <stdlib.h>
+#include <string.h>
+
+#include "hm_test.h"
+#include "hunting_monitor/estimator.h"
+#include "hunting_monitor/linear.h"
+
+/* Allocation counter: the test binary is linked with --wrap for malloc, calloc and realloc. */
+static long n_allocations;
+void *__real_malloc(size_t n);
+void *__real_calloc(size_t n, size_t m);
+void *__real_realloc(void *p, size_t n);
+void *__wrap_malloc(size_t n) {
+  ++n_allocations;
+  return __real_malloc(n);
+}
+void *__wrap_calloc(size_t n, size_t m) {
+  ++n_allocations;
+  return __real_calloc(n, m);
+}
+void *__wrap_realloc(void *p, size_t n) {
+  ++n_allocations;
+  return __real_realloc(p, n);
+}
+
+static double noise(void) {
+  const double u1 = hm_test_uniform(1e-12, 1.0), u2 = hm_test_uniform(0.0, 1.0);
+  return sqrt(-2.0 * log(u1)) * cos(2.0 * HM_PI * u2);
+}
+
+static int all_finite(const hm_estimate *r) {
+  return isfinite(r->time_s) && isfinite(r->speed_kmh) && isfinite(r->amplitude_accel_mps2) &&
+         isfinite(r->frequency_hz) && isfinite(r->amplitude_displacement_m) && isfinite(r->period_spread) &&
+         isfinite(r->rms_mps2) && isfinite(r->conicity) && isfinite(r->conicity_confidence);
+}
+
+static hm_estimator make_tracking(double fs, double tracking_s) {
+  hm_estimator_config c;
+  hm_estimator_config_default(&c);
+  c.sample_rate_hz = fs;
+  c.tracking_time_s = tracking_s;
+  hm_vehicle v;
+  hm_vehicle_default(&v);
+  return hm_estimator_create(&c, &v);
+}
+
+static hm_estimator make(double fs) { return make_tracking(fs, 1.0); }
+
+/* Sinusoids with white noise of one spectral density (10% of the amplitude per sample at 2 kHz, so the same
+ * noise in the band at every rate: a sensor's noise density) and drift (a 1 m/s^2-per-10 s ramp plus a 0.3 Hz
+ * sway), at 200, 2000 and 5000 Hz, with the tracking time holding at least 8 periods (1 s from 8 Hz up): after
+ * the settling time of 2 tracking times the amplitude is within 2% and the frequency within 0.5% at every
+ * 0.5 s read-out. */
+static void sinusoids_with_noise_and_drift(void) {
+  const double rates[] = {200.0, 2000.0, 5000.0}, freqs[] = {4.0, 8.0, 14.4, 18.0}, amps[] = {0.5, 3.0, 20.0};
+  double worst_a = 0.0, worst_f = 0.0;
+  for (int r = 0; r < 3; ++r)
+    for (int fi = 0; fi < 4; ++fi)
+      for (int ai = 0; ai < 3; ++ai) {
+        const double f = freqs[fi], A = amps[ai], fs = rates[r], tracking = fmax(1.0, 8.0 / f);
+        hm_estimator e = make_tracking(fs, tracking);
+        for (long i = 0; i < (long)((6.0 + 2.0 * tracking) * fs); ++i) {
+          const double t = (double)i / fs;
+          if (i % (long)(fs / 50) == 0) hm_estimator_push_speed(e, t, 400.0);
+          const double drift = 0.1 * t + 0.5 * sin(2.0 * HM_PI * 0.3 * t);
+          const double sigma = 0.1 * A * sqrt(fs / 2000.0);
+          hm_estimator_push_accel(e, t, A * sin(2.0 * HM_PI * f * t + 0.3) + sigma * noise() + drift);
+          if (t >= 2.0 * tracking && i % (long)(fs / 2) == 0) {
+            hm_estimate est;
+            hm_estimator_read(e, t, &est);
+            HM_CHECK(est.oscillation_valid, "not settled at %g s", t);
+            const double ea = fabs(est.amplitude_accel_mps2 / A - 1.0), ef = fabs(est.frequency_hz / f - 1.0);
+            worst_a = fmax(worst_a, ea);
+            worst_f = fmax(worst_f, ef);
+            HM_CHECK(ea <= 0.02, "fs %g f %g A %g t %g: amplitude %g", fs, f, A, t, est.amplitude_accel_mps2);
+            HM_CHECK(ef <= 0.005, "fs %g f %g A %g t %g: frequency %g", fs, f, A, t, est.frequency_hz);
+            HM_CHECK_REL(est.amplitude_displacement_m,
+                         est.amplitude_accel_mps2 / pow(2.0 * HM_PI * est.frequency_hz, 2), 1e-12, "a / w^2");
+          }
+        }
+        hm_estimator_destroy(e);
+      }
+  printf("  worst relative error after settling: amplitude %.3f%%, frequency %.3f%%\n", 100 * worst_a, 100 * worst_f);
+}
+
+/* A linear chirp 8 -> 16 Hz over 20 s is tracked with the window's lag (the estimate is the mean frequency of
+ * the last tracking time: f(t - 0.5 s)), within 0.5%; an amplitude step 1 -> 5 m/s^2 settles within 2% in 2 s. */
+static void chirp_and_amplitude_step(void) {
+  hm_estimator e = make(2000.0);
+  double worst = 0.0;
+  for (long i = 0; i < 2000L * 20; ++i) {
+    const double t = i / 2000.0, f = 8.0 + 0.4 * t;
+    hm_estimator_push_speed(e, t, 400.0);
+    hm_estimator_push_accel(e, t, 2.0 * sin(2.0 * HM_PI * (8.0 * t + 0.2 * t * t)));
+    if (t >= 2.0 && i % 1000 == 0) {
+      hm_estimate est;
+      hm_estimator_read(e, t, &est);
+      const double expected = f - 0.4 * 0.5;
+      worst = fmax(worst, fabs(est.frequency_hz / expected - 1.0));
+      HM_CHECK_REL(est.frequency_hz, expected, 0.005, "chirp frequency");
+    }
+  }
+  printf("  chirp: worst relative frequency error %.3f%%\n", 100 * worst);
+  hm_estimator_destroy(e);
+  e = make(2000.0);
+  for (long i = 0; i < 2000L * 14; ++i) {
+    const double t = i / 2000.0;
+    hm_estimator_push_speed(e, t, 400.0);
+    hm_estimator_push_accel(e, t, (t < 10.0 ? 1.0 : 5.0) * sin(2.0 * HM_PI * 12.0 * t));
+    if (i % 200 == 0 && t >= 12.0) {
+      hm_estimate est;
+      hm_estimator_read(e, t, &est);
+      HM_CHECK_REL(est.amplitude_accel_mps2, 5.0, 0.02, "amplitude 2 s after the step");
+    }
+  }
+  hm_estimator_destroy(e);
+}
+
+/* Sliding r.m.s.: a 12 Hz sinusoid of amplitude A gives r.m.s. A |H(12 Hz)| / sqrt(2) (|H| of the 4th-order
+ * Butterworth pair: 1/sqrt(1 + (f/fh)^8) / sqrt(1 + (fl/f)^8)) once 100 m are covered (0.8 s at 450 km/h);
+ * the criterion trips at 5.2 m/s^2. Peaks: 5 Hz inside 0.5-10 Hz, 6 consecutive half-cycle peaks >= 8 m/s^2. */
+static void criteria_against_closed_forms(void) {
+  const double f = 12.0, H = 1.0 / sqrt(1.0 + pow(f / 20.0, 8)) / sqrt(1.0 + pow(2.0 / f, 8));
+  const double amps[2] = {5.2 * sqrt(2.0) / H * 1.05, 5.2 * sqrt(2.0) / H * 0.95};
+  for (int k = 0; k < 2; ++k) {
+    hm_estimator e = make(2000.0);
+    hm_estimate est;
+    for (long i = 0; i < 2000L * 4; ++i) {
+      const double t = i / 2000.0;
+      hm_estimator_push_speed(e, t, 450.0);
+      hm_estimator_push_accel(e, t, amps[k] * sin(2.0 * HM_PI * f * t));
+    }
+    hm_estimator_read(e, 4.0, &est);
+    HM_CHECK(est.rms_window_complete, "window complete");
+    HM_CHECK_REL(est.rms_mps2, amps[k] * H / sqrt(2.0), 0.01, "sliding r.m.s.");
+    HM_CHECK(est.rms_exceeded == (k == 0), "criterion at %.2f of the limit", k ? 0.95 : 1.05);
+    hm_estimator_destroy(e);
+  }
+  const double fp = 5.0, Hp = 1.0 / sqrt(1.0 + pow(fp / 10.0, 8)) / sqrt(1.0 + pow(0.5 / fp, 4));
+  for (int k = 0; k < 2; ++k) {
+    hm_estimator e = make(2000.0);
+    hm_estimate est;
+    const double A = 8.0 / Hp * (k ? 0.95 : 1.05);
+    unsigned at_1s = 0;
+    for (long i = 0; i < 2000L * 3; ++i) {
+      const double t = i / 2000.0;
+      hm_estimator_push_speed(e, t, 300.0);
+      hm_estimator_push_accel(e, t, A * sin(2.0 * HM_PI * fp * t));
+      if (i == 2000) {
+        hm_estimator_read(e, t, &est);
+        at_1s = est.consecutive_peaks;
+      }
+    }
+    hm_estimator_read(e, 3.0, &est);
+    if (k == 0) {
+      HM_CHECK(est.peaks_exceeded && est.consecutive_peaks >= 6, "peaks %u", est.consecutive_peaks);
+      /* from 1 s to 3 s: 2 s x 10 half-cycles per second more */
+      HM_CHECK(est.consecutive_peaks - at_1s == 20, "peaks counted %u in 2 s", est.consecutive_peaks - at_1s);
+    } else {
+      HM_CHECK(!est.peaks_exceeded && est.consecutive_peaks == 0, "peaks %u below the limit", est.consecutive_peaks);
+    }
+    hm_estimator_destroy(e);
+  }
+}
+
+/* Conicity inversion: a sinusoid at the frequency of the linear hunting mode (dgeev) for (lambda, V) gives
+ * lambda back within 0.5%. */
+static void conicity_from_mode_frequency(void) {
+  hm_vehicle v;
+  hm_vehicle_default(&v);
+  const double lambdas[] = {0.08, 0.1358, 0.2, 0.35}, speeds[] = {250.0, 400.0, 550.0};
+  for (int i = 0; i < 4; ++i)
+    for (int j = 0; j < 3; ++j) {
+      double re[4], im[4];
+      HM_CHECK(hm_linear_eigenvalues(&v, lambdas[i], hm_mps_from_kmh(speeds[j]), re, im) == HM_OK, "eig");
+      const double f = fabs(im[0]) / (2.0 * HM_PI); /* the least damped pair: the hunting mode */
+      hm_estimator e = make(2000.0);
+      for (long k = 0; k < 2000L * 5; ++k) {
+        const double t = k / 2000.0;
+        hm_estimator_push_speed(e, t, speeds[j]);
+        hm_estimator_push_accel(e, t, 2.0 * sin(2.0 * HM_PI * f * t) + 0.1 * noise());
+      }
+      hm_estimate est;
+      hm_estimator_read(e, 5.0, &est);
+      HM_CHECK(est.conicity_valid && est.conicity_confidence > 0.5, "lambda %g V %g: valid %d conf %g", lambdas[i],
+               speeds[j], est.conicity_valid, est.conicity_confidence);
+      HM_CHECK_REL(est.conicity, lambdas[i], 0.005, "conicity estimate");
+      hm_estimator_destroy(e);
+    }
+}
+
+/* Bad input is counted and skipped; outputs stay finite; the estimator recovers after a gap. */
+static void bad_input_is_skipped(void) {
+  hm_estimator e = make(2000.0);
+  hm_estimate est;
+  long t_i = 0;
+  for (; t_i < 4000; ++t_i) {
+    hm_estimator_push_speed(e, t_i / 2000.0, 400.0);
+    hm_estimator_push_accel(e, t_i / 2000.0, 2.0 * sin(2.0 * HM_PI * 10.0 * t_i / 2000.0));
+  }
+  const double t = (t_i - 1) / 2000.0;
+  HM_CHECK(hm_estimator_push_accel(e, t + 0.0005, NAN) == HM_EDOMAIN, "NaN sample");
+  HM_CHECK(hm_estimator_push_accel(e, t + 0.0005, INFINITY) == HM_EDOMAIN, "inf sample");
+  HM_CHECK(hm_estimator_push_accel(e, NAN, 1.0) == HM_EDOMAIN, "NaN time");
+  HM_CHECK(hm_estimator_push_accel(e, t + 0.0005, 1e6) == HM_EDOMAIN, "implausible sample");
+  HM_CHECK(hm_estimator_push_accel(e, t, 1.0) == HM_EINVAL, "repeated timestamp");
+  HM_CHECK(hm_estimator_push_accel(e, t - 0.1, 1.0) == HM_EINVAL, "out of order");
+  HM_CHECK(hm_estimator_push_speed(e, t, -5.0) == HM_EDOMAIN, "negative speed");
+  HM_CHECK(hm_estimator_push_speed(e, t + 0.01, NAN) == HM_EDOMAIN, "NaN speed");
+  HM_CHECK(hm_estimator_push_speed(e, t + 0.02, 480.0) == HM_EDOMAIN, "80 km/h jump in 20 ms");
+  HM_CHECK(hm_estimator_push_speed(e, t + 0.03, 700.0) == HM_EDOMAIN, "above max speed");
+  hm_estimator_read(e, t, &est);
+  HM_CHECK(all_finite(&est), "non-finite output after bad input");
+  HM_CHECK(est.n_rejected_nonfinite == 3 && est.n_rejected_range == 1 && est.n_rejected_order == 2 &&
+               est.n_speed_rejected == 4,
+           "counters %lu %lu %lu %lu", est.n_rejected_nonfinite, est.n_rejected_range, est.n_rejected_order,
+           est.n_speed_rejected);
+  HM_CHECK(est.oscillation_valid && fabs(est.frequency_hz - 10.0) < 0.05 && est.speed_kmh == 400.0,
+           "state kept: f %g, v %g", est.frequency_hz, est.speed_kmh);
+  /* stale: no sample for 0.3 s, no speed for 1.5 s */
+  hm_estimator_read(e, t + 0.3, &est);
+  HM_CHECK(!est.accel_valid && est.speed_valid, "acceleration stale after 0.3 s");
+  hm_estimator_read(e, t + 1.5, &est);
+  HM_CHECK(!est.speed_valid, "speed stale after 1.5 s");
+  /* a 0.5 s gap restarts the trackers, which settle again */
+  const double t2 = t + 0.5;
+  for (long i = 0; i < 6000; ++i) {
+    const double ti = t2 + i / 2000.0;
+    hm_estimator_push_speed(e, ti, 400.0);
+    hm_estimator_push_accel(e, ti, 3.0 * sin(2.0 * HM_PI * 15.0 * ti));
+    if (i == 1000) {
+      hm_estimator_read(e, ti, &est);
+      HM_CHECK(!est.oscillation_valid && est.n_gaps == 1, "restart after the gap (gaps %lu)", est.n_gaps);
+    }
+  }
+  hm_estimator_read(e, t2 + 3.0, &est);
+  HM_CHECK(est.oscillation_valid && fabs(est.frequency_hz / 15.0 - 1.0) < 0.005 &&
+               fabs(est.amplitude_accel_mps2 / 3.0 - 1.0) < 0.02 && all_finite(&est),
+           "recovered: f %g A %g", est.frequency_hz, est.amplitude_accel_mps2);
+  hm_estimator_destroy(e);
+}
+
+/* A long stream at 2 kHz (1 hour, or 60 s with --short) with noise, gaps, NaNs and speed changes: no
+ * allocation after create and every read-out finite. */
+static double stream_seconds = 3600.0;
+static void long_stream_no_allocation(void) {
+  hm_estimator e = make(2000.0);
+  const long before = n_allocations;
+  hm_estimate est;
+  int finite = 1;
+  const long n = (long)(stream_seconds * 2000.0);
+  double t = 0.0;
+  for (long i = 0; i < n; ++i) {
+    t += (i % 500000 == 499999) ? 0.2 : 0.0005; /* a gap every 250 s */
+    if (i % 40 == 0) hm_estimator_push_speed(e, t, 300.0 + 200.0 * fabs(sin(t / 600.0)));
+    const double a = (i % 100003 == 0) ? NAN : 3.0 * sin(2.0 * HM_PI * 13.0 * t) + 0.5 * noise();
+    hm_estimator_push_accel(e, t, a);
+    if (i % 2000 == 0) {
+      hm_estimator_read(e, t, &est);
+      finite &= all_finite(&est);
+    }
+  }
+  const long allocations = n_allocations - before;
+  hm_estimator_read(e, t, &est);
+  printf("  %.0f s at 2 kHz: %ld allocations after create, %lu samples, %lu gaps, %lu rejected\n", stream_seconds,
+         allocations, est.n_samples, est.n_gaps, est.n_rejected_nonfinite);
+  HM_CHECK(allocations == 0, "%ld allocations while streaming", allocations);
+  HM_CHECK(finite, "a non-finite output during the stream");
+  hm_estimator_destroy(e);
+}
+
+static void bad_configuration(void) {
+  hm_estimator_config c;
+  char why[160];
+  hm_vehicle v;
+  hm_vehicle_default(&v);
+  hm_estimator_config_default(&c);
+  c.sample_rate_hz = 50.0;
+  HM_CHECK(hm_estimator_config_validate(&c, why, sizeof why) == HM_EDOMAIN && strstr(why, "sample_rate_hz"), "%s", why);
+  HM_CHECK(hm_estimator_create(&c, &v) == NULL, "created with a bad rate");
+  hm_estimator_config_default(&c);
+  c.band_high_hz = 1.0;
+  HM_CHECK(hm_estimator_config_validate(&c, why, sizeof why) == HM_EDOMAIN && strstr(why, "band_high_hz"), "%s", why);
+  hm_estimator_config_default(&c);
+  c.rms_limit_mps2 = NAN;
+  HM_CHECK(hm_estimator_config_validate(&c, why, sizeof why) == HM_EDOMAIN && strstr(why, "rms_limit_mps2"), "%s", why);
+  hm_estimator_config_default(&c);
+  c.peaks_count = 0;
+  HM_CHECK(hm_estimator_config_validate(&c, why, sizeof why) == HM_EDOMAIN && strstr(why, "peaks_count"), "%s", why);
+}
+
+int main(int argc, char **argv) {
+  if (argc > 1 && strcmp(argv[1], "--short") == 0) stream_seconds = 60.0;
+  HM_RUN(sinusoids_with_noise_and_drift);
+  HM_RUN(chirp_and_amplitude_step);
+  HM_RUN(criteria_against_closed_forms);
+  HM_RUN(conicity_from_mode_frequency);
+  HM_RUN(bad_input_is_skipped);
+  HM_RUN(long_stream_no_allocation);
+  HM_RUN(bad_configuration);
+  HM_TEST_EXIT();
+}
