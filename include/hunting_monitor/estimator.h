@@ -20,8 +20,12 @@
  *  - the equivalent conicity: the measured frequency and the current speed inverted through the linear model's
  *    hunting mode: with s = sigma + i w and the characteristic polynomial q(s) + g e lambda (linear.h), the
  *    lambda term is real, so Im q(sigma + i w) = 0 fixes sigma (Newton, from the last sigma) and then
- *    lambda = -Re q(sigma + i w) / (g e). Valid (with a confidence 0..1) only with enough signal, a coherent
- *    frequency and enough speed.
+ *    lambda = -Re q(sigma + i w) / (g e), applied to the frequency averaged over conicity_time_s. Valid only with
+ *    enough signal, a coherent frequency (period spread below conicity_max_spread) and enough speed. Near the Hopf speed the mode frequency hardly depends on lambda
+ *    (on the boundary w^2 = A3/A1 does not at all): the sensitivity S = (dlambda/lambda)/(dw/w) reaches about 15
+ *    at 500 km/h for the CRH380 defaults, so a 1% frequency error is a 15% conicity error. The confidence
+ *    (0..1) is therefore signal strength times 1 - (expected relative error / 10%), the expected error being S
+ *    times the period spread over the square root of the number of periods averaged (0.5: about 5%).
  * Bad input is counted and skipped, never propagated: non-finite or implausibly large samples, repeated or
  * out-of-order timestamps, gaps longer than max_gap_s (which restart the filters and trackers), speeds that are
  * non-finite, negative, above max_speed_kmh or change faster than max_speed_rate_kmh_s. Outputs are never NaN.
@@ -51,6 +55,7 @@ typedef struct {
   double conicity_min_amplitude_mps2;
   double conicity_max_spread;     /* largest relative standard deviation of the periods */
   double conicity_min, conicity_max; /* plausible range of the estimate */
+  double conicity_time_s;         /* averaging time of the conicity estimate */
   double max_gap_s;               /* a longer silence restarts filters and trackers */
   double accel_timeout_s;         /* acceleration older than this is stale */
   double speed_timeout_s;         /* speed older than this is stale */
@@ -61,7 +66,7 @@ typedef struct {
 
 /* Defaults (config/monitor.yaml cites their sources): 2 kHz, band 2-20 Hz, tracking 1 s, r.m.s. over 100 m
  * against 5.2 m/s^2, 6 peaks of 8 m/s^2 in 0.5-10 Hz, conicity from 100 km/h and 0.3 m/s^2 with period spread
- * below 5% in 0.01..1.0, gaps > 0.05 s, stale after 0.2 s (acceleration) / 1 s (speed), speed <= 600 km/h
+ * below 5% in 0.01..1.0 averaged over 10 s, gaps > 0.05 s, stale after 0.2 s (acceleration) / 1 s (speed), speed <= 600 km/h
  * changing <= 30 km/h per second, samples <= 500 m/s^2. */
 void hm_estimator_config_default(hm_estimator_config *cfg);
 
@@ -86,6 +91,7 @@ typedef struct {
   int conicity_valid;
   double conicity;                /* 0 if never valid; the last valid value otherwise */
   double conicity_confidence;     /* 0..1 */
+  double conicity_sensitivity;    /* S = (dlambda/lambda)/(dw/w) at the current speed and frequency (0 if unknown) */
   /* input problems, counted since create or reset */
   unsigned long n_samples, n_rejected_nonfinite, n_rejected_range, n_rejected_order, n_gaps;
   unsigned long n_speed_updates, n_speed_rejected;

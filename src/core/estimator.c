@@ -75,7 +75,8 @@ struct hm_estimator_s {
   double speed_kmh, t_speed;
   /* conicity */
   double sigma;                  /* last root real part of the inversion */
-  double conicity, conicity_conf;
+  double conicity, conicity_conf, conicity_sens;
+  double f_slow, f_slow_periods; /* frequency averaged for the conicity, and how many periods it holds */
   int conicity_ok;
   hm_estimate counters;          /* only the counters are used */
 };
@@ -96,6 +97,7 @@ void hm_estimator_config_default(hm_estimator_config *c) {
   c->conicity_max_spread = 0.05;
   c->conicity_min = 0.01;
   c->conicity_max = 1.0;
+  c->conicity_time_s = 10.0;
   c->max_gap_s = 0.05;
   c->accel_timeout_s = 0.2;
   c->speed_timeout_s = 1.0;
@@ -125,6 +127,7 @@ hm_status hm_estimator_config_validate(const hm_estimator_config *c, char *why, 
                   {"conicity_min_amplitude_mps2", c->conicity_min_amplitude_mps2},
                   {"conicity_max_spread", c->conicity_max_spread},
                   {"conicity_min", c->conicity_min},
+                  {"conicity_time_s", c->conicity_time_s},
                   {"max_gap_s", c->max_gap_s},
                   {"accel_timeout_s", c->accel_timeout_s},
                   {"speed_timeout_s", c->speed_timeout_s},
@@ -219,6 +222,8 @@ void hm_estimator_reset(hm_estimator e) {
   e->sigma = 0.0;
   e->conicity = 0.0;
   e->conicity_conf = 0.0;
+  e->conicity_sens = 0.0;
+  e->f_slow = e->f_slow_periods = 0.0;
   e->conicity_ok = 0;
   memset(&e->counters, 0, sizeof e->counters);
 }
@@ -317,21 +322,33 @@ static void update_conicity(hm_estimator e, double t) {
   const double f = tracked(e, &spread, &a);
   const int speed_ok = e->have_speed && t - e->t_speed <= c->speed_timeout_s &&
                        e->speed_kmh >= c->conicity_min_speed_kmh && e->speed_kmh > 0.0;
-  double lambda = 0.0;
   const int settled = t - e->t_start >= c->tracking_time_s;
-  if (!(settled && speed_ok && f > 0.0 && a >= c->conicity_min_amplitude_mps2 && spread <= c->conicity_max_spread &&
-        invert_conicity(e, e->speed_kmh, f, &lambda) && lambda >= c->conicity_min && lambda <= c->conicity_max)) {
+  if (!(settled && speed_ok && f > 0.0 && a >= c->conicity_min_amplitude_mps2 && spread <= c->conicity_max_spread)) {
+    e->conicity_ok = 0;
+    e->conicity_conf = 0.0;
+    e->f_slow_periods = 0.0;
+    return;
+  }
+  /* the frequency averaged over conicity_time_s (one update per crossing): a plain running mean until that many
+   * periods are in, then an exponential average with the same memory, then inverted */
+  e->f_slow_periods = fmin(e->f_slow_periods + 1.0, fmax(1.0, f * c->conicity_time_s));
+  e->f_slow += (f - e->f_slow) / e->f_slow_periods;
+  double lambda = 0.0, lambda_up = 0.0;
+  const double sigma_before = e->sigma;
+  if (!invert_conicity(e, e->speed_kmh, e->f_slow * 1.001, &lambda_up) ||
+      !invert_conicity(e, e->speed_kmh, e->f_slow, &lambda) || lambda < c->conicity_min || lambda > c->conicity_max) {
+    e->sigma = sigma_before;
     e->conicity_ok = 0;
     e->conicity_conf = 0.0;
     return;
   }
-  /* confidence: signal strength (full at twice the minimum) times coherence (full at zero spread) */
+  /* sensitivity, and the expected relative error: S times the standard error of the averaged frequency */
+  const double S = fabs((lambda_up - lambda) / lambda) / 1e-3;
+  const double expected = S * spread / sqrt(e->f_slow_periods);
   const double strength = fmin(1.0, a / c->conicity_min_amplitude_mps2 - 1.0);
-  const double coherence = 1.0 - spread / c->conicity_max_spread;
-  e->conicity_conf = fmax(0.0, strength) * fmax(0.0, coherence);
-  /* smooth over about one tracking time (one update per crossing) */
-  const double k = fmin(1.0, 1.0 / (f * c->tracking_time_s));
-  e->conicity = e->conicity_ok ? e->conicity + k * (lambda - e->conicity) : lambda;
+  e->conicity_sens = S;
+  e->conicity_conf = fmax(0.0, strength) * fmax(0.0, 1.0 - expected / 0.10);
+  e->conicity = lambda;
   e->conicity_ok = 1;
 }
 
@@ -476,5 +493,6 @@ void hm_estimator_read(const hm_estimator e, double now, hm_estimate *out) {
   r.conicity_valid = e->conicity_ok && r.speed_valid && r.accel_valid;
   r.conicity = e->conicity;
   r.conicity_confidence = r.conicity_valid ? e->conicity_conf : 0.0;
+  r.conicity_sensitivity = e->conicity_ok ? e->conicity_sens : 0.0;
   *out = r;
 }

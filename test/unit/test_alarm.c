@@ -87,6 +87,7 @@ static void stale_input_is_no_data(void) {
   e = estimate(200.0, 0.0);
   hm_alarm_update(a, &e, 0.3, &s);
   HM_CHECK(s.level == HM_LEVEL_OK && s.changed, "data back: %s", hm_level_name(s.level));
+  hm_alarm_destroy(a);
 }
 
 /* Hysteresis and hold: from ALARM (above Hopf) down to 3 km/h below it the level stays ALARM; further down it

@@ -172,6 +172,8 @@ static int same_alarm(const hm_alarm_config *x, const hm_alarm_config *y) { /* f
 static void monitor_settings(void) {
   hm_estimator_config e, de;
   hm_alarm_config a, da;
+  memset(&e, 0, sizeof e); /* padding too, for the memcmp below */
+  memset(&de, 0, sizeof de);
   hm_estimator_config_default(&e);
   hm_estimator_config_default(&de);
   hm_alarm_config_default(&a);

@@ -1,0 +1,186 @@
+/* The online monitor (estimator + alarm) on simulated model output: the nonlinear wheelset driven by a random
+ * lateral track irregularity (excitation.h), sampled like an axle-box accelerometer at 2 kHz with sensor noise. */
+#include <stdlib.h>
+#include <string.h>
+
+#include "hm_test.h"
+#include "hunting_monitor/alarm.h"
+#include "hunting_monitor/cycles.h"
+#include "hunting_monitor/excitation.h"
+#include "hunting_monitor/integrate.h"
+#include "hunting_monitor/linear.h"
+
+static hm_table table;
+static hm_vehicle vehicle;
+static hm_irregularity track, rough; /* 1% and 100% of the low-disturbance spectrum's power */
+
+typedef struct {
+  hm_estimator est;
+  hm_alarm alarm;
+  hm_excited_model em;
+  double next_sample, next_read;
+  double true_amp;         /* running max |y| over the last 0.1 s (the true displacement amplitude) */
+  double true_amp_window;
+  /* what the run saw */
+  double first_alarm_s, t_true_beyond;
+  double edge_m;           /* unstable cycle amplitude at the run's speed (direct continuation) */
+  int levels_seen[5];
+  double conicity_min_seen, conicity_max_seen;
+  int conicity_reads;
+  hm_level last_level;
+} run_state;
+
+static double noise(void) {
+  const double u1 = hm_test_uniform(1e-12, 1.0), u2 = hm_test_uniform(0.0, 1.0);
+  return sqrt(-2.0 * log(u1)) * cos(2.0 * HM_PI * u2);
+}
+
+/* Called after every integration step: sample at 2 kHz from the dense output, feed the monitor, read at 20 Hz. */
+static int feed(hm_dopri integ, double t_old, double t_new, const double *x_new, void *ctx) {
+  run_state *r = (run_state *)ctx;
+  (void)x_new;
+  for (; r->next_sample <= t_new; r->next_sample += 0.0005) {
+    double x[4], dx[4];
+    if (hm_dopri_dense(integ, fmax(r->next_sample, t_old), x) != HM_OK) return 1;
+    hm_excited_rhs(r->next_sample, x, dx, &r->em);
+    const double t = r->next_sample;
+    if (fmod(t, 0.02) < 0.0005) hm_estimator_push_speed(r->est, t, hm_excited_speed_kmh(&r->em, t));
+    hm_estimator_push_accel(r->est, t, dx[1] + 0.05 * noise());
+    r->true_amp_window = fmax(r->true_amp_window, fabs(x[0]));
+    if (t >= r->next_read) {
+      r->true_amp = r->true_amp_window;
+      r->true_amp_window = 0.0;
+      hm_estimate e;
+      hm_assessment s;
+      hm_estimator_read(r->est, t, &e);
+      hm_alarm_update(r->alarm, &e, t, &s);
+      if (t > 2.0) r->levels_seen[s.level]++;
+      if (s.level == HM_LEVEL_ALARM && r->first_alarm_s < 0.0) r->first_alarm_s = t;
+      if (r->edge_m > 0.0 && r->true_amp > r->edge_m && r->t_true_beyond < 0.0) r->t_true_beyond = t;
+      if (e.conicity_valid && e.conicity_confidence >= 0.5) {
+        r->conicity_min_seen = fmin(r->conicity_min_seen, e.conicity);
+        r->conicity_max_seen = fmax(r->conicity_max_seen, e.conicity);
+        r->conicity_reads++;
+      }
+      r->last_level = s.level;
+      r->next_read += 0.05;
+    }
+  }
+  return 0;
+}
+
+static void run_init(run_state *r, double v_kmh) {
+  memset(r, 0, sizeof *r);
+  hm_estimator_config ec;
+  hm_estimator_config_default(&ec);
+  hm_alarm_config ac;
+  hm_alarm_config_default(&ac);
+  r->est = hm_estimator_create(&ec, &vehicle);
+  r->alarm = hm_alarm_create(&ac, table);
+  hm_excited_model_init(&r->em, &vehicle, &track, v_kmh, v_kmh, 0.0);
+  r->first_alarm_s = r->t_true_beyond = -1.0;
+  r->conicity_min_seen = INFINITY;
+  r->conicity_max_seen = -INFINITY;
+}
+
+static void run_segment(run_state *r, double t0, double t1, double *x) {
+  hm_dopri d = hm_dopri_create(4);
+  const hm_ode_system sys = {4, hm_excited_rhs, NULL, &r->em};
+  const hm_dopri_options o = {1e-8, 1e-11, 0.0, 2e-3, 0};
+  HM_CHECK(hm_dopri_integrate(d, &sys, &o, t0, t1, x, NULL, feed, r, NULL) == HM_OK, "simulate %g..%g s", t0, t1);
+  hm_dopri_destroy(d);
+}
+
+static void run_free(run_state *r) {
+  hm_estimator_destroy(r->est);
+  hm_alarm_destroy(r->alarm);
+}
+
+/* 200 km/h, below the lowest speed with any cycle (about 239.5 km/h): 30 s on the full low-disturbance track,
+ * level OK throughout. */
+static void below_lowest_cycle_speed_stays_ok(void) {
+  run_state r;
+  run_init(&r, 200.0);
+  r.em.irr = &rough;
+  double x[4] = {0, 0, 0, 0};
+  run_segment(&r, 0.0, 30.0, x);
+  printf("  200 km/h: levels after 2 s: OK %d, WATCH %d, WARN %d, ALARM %d\n", r.levels_seen[1], r.levels_seen[2],
+         r.levels_seen[3], r.levels_seen[4]);
+  HM_CHECK(r.levels_seen[HM_LEVEL_OK] > 0 && r.levels_seen[HM_LEVEL_WATCH] + r.levels_seen[HM_LEVEL_WARN] +
+                                                   r.levels_seen[HM_LEVEL_ALARM] + r.levels_seen[HM_LEVEL_NO_DATA] == 0,
+           "not OK throughout");
+  run_free(&r);
+}
+
+/* 505 km/h, in the bistable band, on a smooth track (1% of the low-disturbance spectrum's power: with all of it
+ * the track itself kicks this wheelset into hunting within seconds, as MODEL.md section 7 warns): 12 s of
+ * excitation (WATCH or WARN, never ALARM; every confident conicity estimate within 10% of the true 0.1358),
+ * then a disturbance just beyond the unstable cycle: sustained hunting on the large stable cycle, and ALARM
+ * within 1 s of the true amplitude passing the unstable cycle (the edge of the basin, from direct continuation). */
+static void hunting_onset_alarms_within_a_second(void) {
+  const double v = 505.0;
+  /* the unstable cycle at 505 km/h: continuation of the family from the Hopf point */
+  hm_hopf_point h;
+  size_t n = 0, np = 0, ne = 0;
+  hm_hopf_find(&vehicle, 500.0, HM_PARAM_SPEED, 100.0, 900.0, 1e-10, &h, 1, &n);
+  hm_cycle_options o;
+  hm_cycle_options_default(&o, HM_PARAM_SPEED);
+  o.amp_max_m = 0.009;
+  enum { CAP = 4000 };
+  hm_cycle_point *pts = malloc(CAP * sizeof *pts);
+  hm_cycle_event ev[8];
+  hm_cycles_continue(&vehicle, 500.0, &h, &o, pts, CAP, &np, ev, 8, &ne, NULL);
+  const hm_cycle_point *edge = NULL;
+  for (size_t i = 1; i < np; ++i) /* the unstable cycle beyond LPC2 crossing 505 km/h */
+    if ((pts[i - 1].param - v) * (pts[i].param - v) <= 0.0 && pts[i].amp_y_m > 0.006) edge = &pts[i];
+  HM_CHECK(edge != NULL, "no unstable cycle at 505 km/h");
+  if (!edge) {
+    free(pts);
+    return;
+  }
+  run_state r;
+  run_init(&r, v);
+  double x[4] = {0, 0, 0, 0};
+  run_segment(&r, 0.0, 12.0, x);
+  printf("  505 km/h, 12 s excitation: OK %d, WATCH %d, WARN %d, ALARM %d; conicity %.4f..%.4f (%d reads)\n",
+         r.levels_seen[1], r.levels_seen[2], r.levels_seen[3], r.levels_seen[4], r.conicity_min_seen,
+         r.conicity_max_seen, r.conicity_reads);
+  HM_CHECK(r.first_alarm_s < 0.0 && r.levels_seen[HM_LEVEL_WATCH] + r.levels_seen[HM_LEVEL_WARN] > 0 &&
+               r.levels_seen[HM_LEVEL_OK] == 0,
+           "false alarm, or not WATCH/WARN before the kick");
+  HM_CHECK(r.conicity_reads > 20, "too few confident conicity estimates (%d)", r.conicity_reads);
+  HM_CHECK(r.conicity_min_seen >= 0.9 * 0.1358 && r.conicity_max_seen <= 1.1 * 0.1358,
+           "conicity estimates %.4f..%.4f not within 10%% of 0.1358", r.conicity_min_seen, r.conicity_max_seen);
+  /* the kick: the state of the unstable cycle scaled by 1.05 (outside the basin of the origin) */
+  r.edge_m = edge->amp_y_m;
+  for (int i = 0; i < 4; ++i) x[i] = 1.05 * edge->x0[i];
+  run_segment(&r, 12.0, 18.0, x);
+  printf("  kick at 12 s: true amplitude beyond the %.2f mm edge at %.2f s, ALARM at %.2f s, final level %s, "
+         "true amplitude %.2f mm\n",
+         r.edge_m * 1e3, r.t_true_beyond, r.first_alarm_s, hm_level_name(r.last_level), r.true_amp * 1e3);
+  HM_CHECK(r.t_true_beyond >= 12.0 && r.first_alarm_s >= 12.0, "no exceedance or no alarm");
+  HM_CHECK(r.first_alarm_s <= r.t_true_beyond + 1.0, "ALARM %.2f s after the exceedance",
+           r.first_alarm_s - r.t_true_beyond);
+  HM_CHECK(r.last_level == HM_LEVEL_ALARM && r.true_amp > 0.012, "sustained hunting not alarmed");
+  run_free(&r);
+  free(pts);
+}
+
+int main(void) {
+  hm_vehicle_default(&vehicle);
+  hm_irregularity_generate(&track, 200, 3.0, 120.0, 0.01, 42);
+  hm_irregularity_generate(&rough, 200, 3.0, 120.0, 1.0, 42);
+  hm_table_spec spec;
+  hm_table_spec_default(&spec);
+  spec.conicity_min = 0.12;
+  spec.conicity_max = 0.16;
+  spec.n_conicity = 3;
+  if (hm_table_build(&vehicle, &spec, &table) != HM_OK) {
+    printf("FAIL table_build\n");
+    return 1;
+  }
+  HM_RUN(below_lowest_cycle_speed_stays_ok);
+  HM_RUN(hunting_onset_alarms_within_a_second);
+  hm_table_destroy(table);
+  HM_TEST_EXIT();
+}
