@@ -5,7 +5,9 @@
 #include <stdlib.h>
 #include <time.h>
 
+#include "hunting_monitor/alarm.h"
 #include "hunting_monitor/conicity_fit.h"
+#include "hunting_monitor/estimator.h"
 #include "hunting_monitor/cycles.h"
 #include "hunting_monitor/hopf.h"
 #include "hunting_monitor/tables.h"
@@ -174,6 +176,56 @@ static double bench_fit(int reps, double *rmse) {
   return best;
 }
 
+/* Online monitor per sample at 2 kHz: the estimator alone, and the estimator plus a read-out and an alarm
+ * (margin) update after every sample (the worst case: a node reads at its status rate, e.g. 20 Hz). */
+static void bench_monitor(double *ns_push, double *ns_push_update, double *ns_read_update) {
+  hm_vehicle v;
+  hm_vehicle_default(&v);
+  hm_estimator_config ec;
+  hm_estimator_config_default(&ec);
+  hm_alarm_config ac;
+  hm_alarm_config_default(&ac);
+  hm_table_spec spec;
+  hm_table_spec_default(&spec);
+  spec.conicity_min = 0.12;
+  spec.conicity_max = 0.16;
+  spec.n_conicity = 3;
+  hm_table t = NULL;
+  *ns_push = *ns_push_update = *ns_read_update = -1.0;
+  if (hm_table_build(&v, &spec, &t) != HM_OK) return;
+  hm_estimator e = hm_estimator_create(&ec, &v);
+  hm_alarm a = hm_alarm_create(&ac, t);
+  const long n = 2000L * 600; /* 10 minutes of data */
+  double *x = malloc((size_t)n * sizeof(double));
+  for (long i = 0; i < n; ++i) x[i] = 3.0 * sin(2.0 * HM_PI * 14.0 * (double)i / 2000.0) + 0.01 * (double)(i % 7);
+  double t0 = now_s();
+  for (long i = 0; i < n; ++i) {
+    if (i % 40 == 0) hm_estimator_push_speed(e, (double)i / 2000.0, 450.0);
+    hm_estimator_push_accel(e, (double)i / 2000.0, x[i]);
+  }
+  *ns_push = (now_s() - t0) / (double)n * 1e9;
+  hm_estimator_reset(e);
+  hm_estimate est;
+  hm_assessment s;
+  double t_update = 0.0;
+  t0 = now_s();
+  for (long i = 0; i < n; ++i) {
+    const double t_s = (double)i / 2000.0;
+    if (i % 40 == 0) hm_estimator_push_speed(e, t_s, 450.0);
+    hm_estimator_push_accel(e, t_s, x[i]);
+    const double t1 = now_s();
+    hm_estimator_read(e, t_s, &est);
+    hm_alarm_update(a, &est, t_s, &s);
+    t_update += now_s() - t1;
+  }
+  *ns_push_update = (now_s() - t0) / (double)n * 1e9;
+  *ns_read_update = t_update / (double)n * 1e9;
+  free(x);
+  hm_alarm_destroy(a);
+  hm_estimator_destroy(e);
+  hm_table_destroy(t);
+}
+
 int main(void) {
   hm_vehicle veh;
   hm_vehicle_default(&veh);
@@ -229,6 +281,8 @@ int main(void) {
   bench_table(&parse_us, &lookup_ns, &table_bytes);
   double fit_rmse = 0.0;
   const double fit_s = bench_fit(20, &fit_rmse);
+  double ns_push, ns_push_update, ns_read_update;
+  bench_monitor(&ns_push, &ns_push_update, &ns_read_update);
 
   printf("{\n");
   printf("  \"closed_form_critical_speeds_per_s\": %.4g,\n", closed_per_s);
@@ -250,7 +304,11 @@ int main(void) {
   printf("  \"table_parse_us\": %.4g,\n", parse_us);
   printf("  \"table_lookup_ns\": %.4g,\n", lookup_ns);
   printf("  \"conicity_fit_500_points_3_terms_ms\": %.4g,\n", fit_s * 1e3);
-  printf("  \"conicity_fit_rmse\": %.5f\n", fit_rmse);
+  printf("  \"conicity_fit_rmse\": %.5f,\n", fit_rmse);
+  printf("  \"estimator_ns_per_sample\": %.4g,\n", ns_push);
+  printf("  \"estimator_plus_margin_update_every_sample_ns\": %.4g,\n", ns_push_update);
+  printf("  \"read_and_margin_update_ns\": %.4g,\n", ns_read_update);
+  printf("  \"cpu_share_at_2khz_with_every_sample_update_percent\": %.4g\n", ns_push_update * 2000.0 * 1e-9 * 100.0);
   printf("}\n");
   return sink == 12345.678 ? 1 : 0;
 }

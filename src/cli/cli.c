@@ -256,7 +256,18 @@ static int split_commas(char *line, char **fields, int max) {
   return strchr(p, ',') ? max + 1 : k;
 }
 
-int cli_read_csv(const char *path, int ncols, char header[][64], double **data, size_t *n) {
+/* strtod that accepts nan/inf (for recorded data). */
+static int parse_any_double(const char *s, double *out) {
+  char *end = NULL;
+  errno = 0;
+  const double v = strtod(s, &end);
+  if (end == s || *end != '\0') return 1;
+  *out = v;
+  return 0;
+}
+
+int cli_read_csv(const char *path, int ncols, char header[][64], double **data, size_t *n,
+                 int allow_nonfinite) {
   FILE *f = fopen(path, "r");
   if (!f) {
     fprintf(stderr, "hunting: %s: cannot open: %s\n", path, strerror(errno));
@@ -297,12 +308,14 @@ int cli_read_csv(const char *path, int ncols, char header[][64], double **data, 
       }
       d = bigger;
     }
-    for (int c = 0; c < ncols && rc == 0; ++c)
-      if (parse_double(fields[c], &d[rows * (size_t)ncols + (size_t)c])) {
-        fprintf(stderr, "hunting: %s:%zu: column '%s': expected a finite number, got '%s'\n", path, lineno,
-                header[c], fields[c]);
+    for (int c = 0; c < ncols && rc == 0; ++c) {
+      double *slot = &d[rows * (size_t)ncols + (size_t)c];
+      if (allow_nonfinite ? parse_any_double(fields[c], slot) : parse_double(fields[c], slot)) {
+        fprintf(stderr, "hunting: %s:%zu: column '%s': expected a %snumber, got '%s'\n", path, lineno, header[c],
+                allow_nonfinite ? "" : "finite ", fields[c]);
         rc = 1;
       }
+    }
     ++rows;
   }
   if (rc == 0 && ferror(f)) {

@@ -68,9 +68,10 @@ void jw_finish(json_writer *w);
  * Read a CSV file with a header line and ncols numeric columns ('#' comment lines and blank lines skipped).
  * header[k] receives the k-th column name (trimmed, up to 63 characters); *data (malloc'd, row-major
  * n x ncols) and *n the rows. Prints "hunting: FILE:LINE: reason" and returns nonzero on any error (missing
- * file, wrong column count, a value that is not a finite number).
+ * file, wrong column count, a value that is not a number, or not finite unless allow_nonfinite: recorded
+ * sensor data may hold nan or inf, which the online code must see as it would live).
  */
-int cli_read_csv(const char *path, int ncols, char header[][64], double **data, size_t *n);
+int cli_read_csv(const char *path, int ncols, char header[][64], double **data, size_t *n, int allow_nonfinite);
 
 /* Commands implemented in cmd_bifurcation.c */
 extern const cli_option hopf_opts[], cycles_opts[], hopf_curve_opts[], lpc_curve_opts[];

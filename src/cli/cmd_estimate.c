@@ -134,14 +134,14 @@ int cmd_estimate(const cli_args *a) {
   char h_acc[2][64], h_spd[2][64];
   double *acc = NULL, *spd = NULL;
   size_t n_acc = 0, n_spd = 0;
-  if (cli_read_csv(accel_path, 2, h_acc, &acc, &n_acc)) return 1;
+  if (cli_read_csv(accel_path, 2, h_acc, &acc, &n_acc, 1)) return 1;
   int rc = 0;
   if (strcmp(h_acc[0], "t_s") != 0 || strcmp(h_acc[1], "accel_mps2") != 0) {
     fprintf(stderr, "hunting estimate: %s: the header must be 't_s,accel_mps2'\n", accel_path);
     rc = 1;
   }
   if (rc == 0 && speed_path) {
-    rc = cli_read_csv(speed_path, 2, h_spd, &spd, &n_spd);
+    rc = cli_read_csv(speed_path, 2, h_spd, &spd, &n_spd, 1);
     if (rc == 0 && (strcmp(h_spd[0], "t_s") != 0 || strcmp(h_spd[1], "speed_kmh") != 0)) {
       fprintf(stderr, "hunting estimate: %s: the header must be 't_s,speed_kmh'\n", speed_path);
       rc = 1;
@@ -159,7 +159,7 @@ int cmd_estimate(const cli_args *a) {
     rc = 1;
   }
   size_t k = 0;
-  double next_out = n_acc ? acc[0] + every : 0.0;
+  double next_out = n_acc ? acc[0] + every : 0.0, t_written = -INFINITY, t_last = -INFINITY;
   for (size_t i = 0; rc == 0 && i < n_acc; ++i) {
     const double t = acc[2 * i];
     if (spd)
@@ -167,14 +167,24 @@ int cmd_estimate(const cli_args *a) {
     else if (i % 10 == 0)
       hm_estimator_push_speed(est, t, v_const);
     hm_estimator_push_accel(est, t, acc[2 * i + 1]);
-    if (isfinite(t) && t >= next_out) {
+    if (isfinite(t)) t_last = fmax(t_last, t);
+    /* one line per interval of data time, and one at the end of the data */
+    if (isfinite(t) && (t >= next_out || i + 1 == n_acc)) {
       hm_estimate e;
       hm_assessment s;
       hm_estimator_read(est, t, &e);
       hm_alarm_update(alarm, &e, t, &s);
       write_line(&e, &s, t);
-      next_out = t + every - fmod(t - next_out, every);
+      t_written = t;
+      if (t >= next_out) next_out = t + every - fmod(t - next_out, every);
     }
+  }
+  if (rc == 0 && isfinite(t_last) && t_written < t_last) { /* the last rows were not finite times */
+    hm_estimate e;
+    hm_assessment s;
+    hm_estimator_read(est, t_last, &e);
+    hm_alarm_update(alarm, &e, t_last, &s);
+    write_line(&e, &s, t_last);
   }
   hm_alarm_destroy(alarm);
   hm_estimator_destroy(est);

@@ -110,7 +110,7 @@ int cmd_fit_conicity(const cli_args *a) {
   char header[2][64];
   double *d = NULL;
   size_t n = 0;
-  if (cli_read_csv(a->positional, 2, header, &d, &n)) return 1;
+  if (cli_read_csv(a->positional, 2, header, &d, &n, 0)) return 1;
   const char *y_name = scale == 1.0 ? "y_m" : "y_mm";
   if (strcmp(header[0], y_name) != 0 || strcmp(header[1], "conicity") != 0) {
     fprintf(stderr, "hunting fit-conicity: %s: the header must be '%s,conicity' (got '%s,%s')%s\n", a->positional,

@@ -6,6 +6,7 @@
 
 #include "cli.h"
 #include "hunting_monitor/config.h"
+#include "hunting_monitor/excitation.h"
 #include "hunting_monitor/integrate.h"
 #include "hunting_monitor/linear.h"
 #include "hunting_monitor/lyapunov.h"
@@ -121,11 +122,17 @@ static int cmd_eig(const cli_args *a) {
 /* ---- simulate ---- */
 
 static const cli_option simulate_opts[] = {
-    {"v", "KM/H", "running speed (required)"},
+    {"v", "KM/H", "running speed (required; the start speed with --v-end)"},
+    {"v-end", "KM/H", "ramp the speed linearly from --v to this over --t"},
     {"x0", "Y,DY,PSI,DPSI", "initial state [m, m/s, rad, rad/s] (default 0.001,0,0,0)"},
     {"t", "SECONDS", "simulated time (default 10)"},
     {"dt-out", "SECONDS", "output interval, dense output of the integrator (default 0.001)"},
     {"out", "FILE", "write the CSV there instead of stdout"},
+    {"irregularity", "SCALE", "lateral track irregularity: power of the German low-disturbance spectrum x SCALE"},
+    {"seed", "N", "random phases of the irregularity (default 1)"},
+    {"accel-out", "FILE", "also write a sensor stream t_s,accel_mps2 (at --dt-out, with --accel-noise)"},
+    {"speed-out", "FILE", "also write a sensor stream t_s,speed_kmh (at 10 Hz)"},
+    {"accel-noise", "SIGMA", "white noise [m/s^2] added to --accel-out (default 0)"},
     {"linear", NULL, "linear model: constant conicity lambda(0), no flange force"},
     {"rtol", "R", "relative tolerance of Dormand-Prince 5(4) (default 1e-9)"},
     {"atol", "A", "absolute tolerance (default 1e-12)"},
@@ -133,19 +140,34 @@ static const cli_option simulate_opts[] = {
     {NULL, NULL, NULL}};
 
 typedef struct {
-  FILE *out;
-  const hm_model *model;
-  double dt_out;
+  FILE *out, *accel_out, *speed_out;
+  hm_excited_model *em;
+  double dt_out, accel_noise;
   size_t next_index; /* next output time = next_index * dt_out */
-  double t1;
+  double t1, next_speed;
+  unsigned long long rng;
   hm_status error;
 } sim_writer;
 
+static double sim_noise(sim_writer *w) { /* Box-Muller on splitmix64 */
+  double u[2];
+  for (int k = 0; k < 2; ++k) {
+    unsigned long long z = (w->rng += 0x9E3779B97F4A7C15ull);
+    z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9ull;
+    z = (z ^ (z >> 27)) * 0x94D049BB133111EBull;
+    u[k] = ((double)((z ^ (z >> 31)) >> 11) + 0.5) / 9007199254740992.0;
+  }
+  return sqrt(-2.0 * log(u[0])) * cos(2.0 * HM_PI * u[1]);
+}
+
 static void write_row(sim_writer *w, double t, const double *x) {
   double dx[4];
-  hm_status st = hm_model_rhs(t, x, dx, (void *)w->model);
+  hm_status st = hm_excited_rhs(t, x, dx, w->em);
   if (st != HM_OK) w->error = st;
   fprintf(w->out, "%.9g,%.12g,%.12g,%.12g,%.12g,%.12g\n", t, x[0], x[1], x[2], x[3], dx[1]);
+  if (w->accel_out) fprintf(w->accel_out, "%.9g,%.9g\n", t, dx[1] + w->accel_noise * sim_noise(w));
+  for (; w->speed_out && w->next_speed <= t + 1e-12; w->next_speed += 0.1)
+    fprintf(w->speed_out, "%.9g,%.9g\n", w->next_speed, hm_excited_speed_kmh(w->em, w->next_speed));
 }
 
 static int sim_observer(hm_dopri integ, double t_old, double t_new, const double *x_new, void *ctx) {
@@ -166,41 +188,75 @@ static int sim_observer(hm_dopri integ, double t_old, double t_new, const double
   return 0;
 }
 
+/* Open each requested output file (NULL where not requested); nonzero on failure. */
+static int open_outputs(const cli_args *a, FILE **out, FILE **acc, FILE **spd) {
+  const char *names[3] = {"out", "accel-out", "speed-out"};
+  FILE **files[3] = {out, acc, spd};
+  for (int k = 0; k < 3; ++k) {
+    const char *p = cli_value(a, names[k]);
+    *files[k] = p ? fopen(p, "w") : NULL;
+    if (p && !*files[k]) {
+      perror(p);
+      return 1;
+    }
+  }
+  if (!*out) *out = stdout;
+  return 0;
+}
+
+static void close_outputs(FILE *out, FILE *acc, FILE *spd) {
+  if (out && out != stdout) fclose(out);
+  if (acc) fclose(acc);
+  if (spd) fclose(spd);
+}
+
 static int cmd_simulate(const cli_args *a) {
   hm_vehicle veh, lin;
   double v_kmh, x[4] = {0.001, 0.0, 0.0, 0.0}, t_end = 10.0, dt_out = 0.001, rtol = 1e-9, atol = 1e-12;
+  double v_end = NAN, scale = 0.0, seed = 1.0, noise = 0.0;
   if (cli_vehicle(a, &veh, NULL) || cli_speed_option(a, &v_kmh) || cli_number_list(a, "x0", x, 4) ||
       cli_number(a, "t", &t_end) || cli_number(a, "dt-out", &dt_out) || cli_number(a, "rtol", &rtol) ||
-      cli_number(a, "atol", &atol))
+      cli_number(a, "atol", &atol) || cli_number(a, "v-end", &v_end) || cli_number(a, "irregularity", &scale) ||
+      cli_number(a, "seed", &seed) || cli_number(a, "accel-noise", &noise))
     return 1;
-  if (!(t_end > 0.0) || !(dt_out > 0.0) || t_end / dt_out > 1e8 || !(rtol > 0.0) || !(atol >= 0.0)) {
-    fprintf(stderr, "hunting simulate: need --t > 0, --dt-out > 0 (at most 1e8 rows), --rtol > 0, --atol >= 0\n");
+  if (isnan(v_end)) v_end = v_kmh;
+  if (!(t_end > 0.0) || !(dt_out > 0.0) || t_end / dt_out > 1e8 || !(rtol > 0.0) || !(atol >= 0.0) ||
+      !(v_end > 0.0) || !(scale >= 0.0) || !(noise >= 0.0) || seed < 0.0 || seed != floor(seed)) {
+    fprintf(stderr, "hunting simulate: need --t > 0, --dt-out > 0 (at most 1e8 rows), --rtol > 0, --atol >= 0, "
+                    "--v-end > 0, --irregularity >= 0, --accel-noise >= 0 and a whole --seed >= 0\n");
     return 1;
   }
   if (cli_has(a, "linear")) {
     hm_vehicle_linearized(&veh, &lin);
     veh = lin;
   }
-  hm_model model;
-  hm_status st = hm_model_init(&model, &veh, hm_mps_from_kmh(v_kmh));
+  hm_irregularity irr;
+  if (scale > 0.0 && hm_irregularity_generate(&irr, 200, 3.0, 120.0, scale, (uint64_t)seed) != HM_OK)
+    return fail_status("irregularity", HM_EINVAL);
+  hm_excited_model em;
+  hm_status st = hm_excited_model_init(&em, &veh, scale > 0.0 ? &irr : NULL, v_kmh, v_end, t_end);
   if (st != HM_OK) return fail_status("model", st);
-  const char *path = cli_value(a, "out");
-  FILE *out = path ? fopen(path, "w") : stdout;
-  if (!out) {
-    perror(path);
+  FILE *out = NULL, *acc = NULL, *spd = NULL;
+  if (open_outputs(a, &out, &acc, &spd)) {
+    close_outputs(out, acc, spd);
     return 1;
   }
   fprintf(out, "t_s,y_m,dy_mps,psi_rad,dpsi_radps,accel_lat_mps2\n");
-  sim_writer w = {out, &model, dt_out, 1, t_end, HM_OK};
+  if (acc) fprintf(acc, "t_s,accel_mps2\n");
+  if (spd) fprintf(spd, "t_s,speed_kmh\n");
+  sim_writer w = {out, acc, spd, &em, dt_out, noise, 1, t_end, 0.0, (unsigned long long)seed * 7919u + 17u, HM_OK};
   write_row(&w, 0.0, x);
   hm_dopri integ = hm_dopri_create(4);
-  if (!integ) return fail_status("integrator", HM_ENOMEM);
-  const hm_ode_system sys = {4, hm_model_rhs, hm_model_jacobian, &model};
-  const hm_dopri_options opt = {rtol, atol, 0.0, 0.0, 0};
+  if (!integ) {
+    close_outputs(out, acc, spd);
+    return fail_status("integrator", HM_ENOMEM);
+  }
+  const hm_ode_system sys = {4, hm_excited_rhs, NULL, &em};
+  const hm_dopri_options opt = {rtol, atol, 0.0, scale > 0.0 ? 2e-3 : 0.0, 0};
   st = hm_dopri_integrate(integ, &sys, &opt, 0.0, t_end, x, NULL, sim_observer, &w, NULL);
   hm_dopri_destroy(integ);
   if (st == HM_OK) st = w.error;
-  if (path) fclose(out);
+  close_outputs(out, acc, spd);
   if (st != HM_OK) return fail_status("simulation (the trajectory diverged or the step size collapsed)", st);
   return 0;
 }
@@ -359,7 +415,8 @@ static const command commands[] = {
      "Eigenvalues [1/s] of the linearised model at the origin and whether it is stable.", eig_opts, cmd_eig},
     {"simulate", "time integration of the nonlinear model to CSV", "--v KM/H [--x0 Y,DY,PSI,DPSI] [--t SECONDS] [options]",
      "Integrate the nonlinear model (Dormand-Prince 5(4), error control, dense output) and write CSV:\n"
-     "t_s,y_m,dy_mps,psi_rad,dpsi_radps,accel_lat_mps2 (the lateral acceleration is dy'/dt of the model).",
+     "t_s,y_m,dy_mps,psi_rad,dpsi_radps,accel_lat_mps2 (the lateral acceleration is dy'/dt of the model);\n"
+     "optionally on an irregular track along a speed ramp, with sensor streams for 'hunting estimate'.",
      simulate_opts, cmd_simulate},
     {"lyapunov", "Lyapunov exponent spectrum of a trajectory", "--v KM/H [--linear] [options]",
      "Lyapunov exponent spectrum [1/s] of a trajectory (Benettin with QR re-orthonormalisation), by the\n"

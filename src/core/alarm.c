@@ -15,6 +15,9 @@ struct hm_alarm_s {
   int lower_pending;      /* the conditions for a lower level hold since lower_since */
   double lower_since;
   int using_estimate;     /* the conicity estimate is in use (entered at the confidence threshold, left below half) */
+  int have_lookup;        /* the last table lookup, reused while conicity and speed are unchanged */
+  double lookup_conicity, lookup_speed;
+  hm_table_lookup_result lookup;
 };
 
 const char *hm_level_name(hm_level l) {
@@ -127,7 +130,13 @@ hm_status hm_alarm_update(hm_alarm a, const hm_estimate *e, double now, hm_asses
     a->using_estimate = c->use_conicity_estimate && e->conicity_valid && e->conicity_confidence >= need;
     s.conicity_from_estimate = a->using_estimate;
     s.conicity = s.conicity_from_estimate ? e->conicity : c->conicity_fallback;
-    if (hm_table_lookup(a->table, s.conicity, e->speed_kmh, &s.boundaries) != HM_OK) return HM_EINVAL;
+    if (!a->have_lookup || a->lookup_conicity != s.conicity || a->lookup_speed != e->speed_kmh) {
+      if (hm_table_lookup(a->table, s.conicity, e->speed_kmh, &a->lookup) != HM_OK) return HM_EINVAL;
+      a->have_lookup = 1;
+      a->lookup_conicity = s.conicity;
+      a->lookup_speed = e->speed_kmh;
+    }
+    s.boundaries = a->lookup;
     s.boundaries_valid = 1;
     s.margin_hopf_kmh = s.boundaries.hopf_speed_kmh - e->speed_kmh;
     s.margin_lowest_cycle_kmh = s.boundaries.lowest_cycle_speed_kmh - e->speed_kmh;

@@ -77,6 +77,8 @@ struct hm_estimator_s {
   double sigma;                  /* last root real part of the inversion */
   double conicity, conicity_conf, conicity_sens;
   double f_slow, f_slow_periods; /* frequency averaged for the conicity, and how many periods it holds */
+  /* the tracked oscillation as of the last crossing (the crossing ring changes only there) */
+  double trk_f, trk_spread, trk_amp;
   int conicity_ok;
   hm_estimate counters;          /* only the counters are used */
 };
@@ -170,6 +172,8 @@ static void restart_signal(hm_estimator e) {
   e->ms = 0.0;
   e->cross_head = e->cross_n = 0;
   e->sum_sq = e->count = 0.0;
+  e->trk_f = e->trk_amp = 0.0;
+  e->trk_spread = 1.0;
   e->armed = 0;
   e->ring_head = e->ring_n = e->since_resum = 0;
   e->ring_sum = e->ring_dist = 0.0;
@@ -318,8 +322,7 @@ static int invert_conicity(hm_estimator e, double speed_kmh, double f_hz, double
 
 static void update_conicity(hm_estimator e, double t) {
   const hm_estimator_config *c = &e->cfg;
-  double spread, a;
-  const double f = tracked(e, &spread, &a);
+  const double f = e->trk_f, spread = e->trk_spread, a = e->trk_amp;
   const int speed_ok = e->have_speed && t - e->t_speed <= c->speed_timeout_s &&
                        e->speed_kmh >= c->conicity_min_speed_kmh && e->speed_kmh > 0.0;
   const int settled = t - e->t_start >= c->tracking_time_s;
@@ -438,6 +441,7 @@ hm_status hm_estimator_push_accel(hm_estimator e, double t, double a) {
     e->cross_head = (e->cross_head + 1) % e->cross_cap;
     if (e->cross_n < e->cross_cap) ++e->cross_n;
     e->armed = 0;
+    e->trk_f = tracked(e, &e->trk_spread, &e->trk_amp);
     update_conicity(e, t);
   }
   e->x_prev = x;
@@ -475,8 +479,7 @@ void hm_estimator_read(const hm_estimator e, double now, hm_estimate *out) {
   r.accel_valid = e->have_sample && isfinite(now) && now - e->t_last <= c->accel_timeout_s && now >= e->t_last - 1.0;
   r.speed_valid = e->have_speed && isfinite(now) && now - e->t_speed <= c->speed_timeout_s;
   r.speed_kmh = e->have_speed ? e->speed_kmh : 0.0;
-  double spread = 1.0, amp = 0.0;
-  const double f = e->have_sample ? tracked(e, &spread, &amp) : 0.0;
+  const double f = e->have_sample ? e->trk_f : 0.0, spread = e->trk_spread, amp = e->trk_amp;
   const int settled = e->have_sample && e->t_last - e->t_start >= c->tracking_time_s;
   r.oscillation_valid = settled && f > 0.0;
   r.amplitude_accel_mps2 = e->have_sample ? (r.oscillation_valid ? amp : amplitude(e)) : 0.0;

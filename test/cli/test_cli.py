@@ -146,7 +146,7 @@ def test_help_is_available():
     p = run("--help")
     assert "critical" in p.stdout and "simulate" in p.stdout
     for cmd in ["critical", "critical-conicity", "eig", "simulate", "lyapunov", "sweep", "hopf", "cycles",
-                "hopf-curve", "lpc-curve", "tables", "table-lookup", "fit-conicity"]:
+                "hopf-curve", "lpc-curve", "tables", "table-lookup", "fit-conicity", "estimate"]:
         p = run(cmd, "--help")
         assert p.stdout.startswith(f"usage: hunting {cmd}"), p.stdout
     assert run(ok=False).returncode == 2
@@ -331,6 +331,69 @@ def test_tables_and_lookup():
             f.write("hunting_monitor_boundary_table 1\nkx_mn_m 8.96\n")
         p = run("table-lookup", "--table", bad, "--conicity", "0.13", "--v", "300", ok=False)
         assert p.returncode != 0 and "line 2: expected 'ky_mn_m'" in p.stderr, p.stderr
+
+
+def lines(text):
+    return [json.loads(line) for line in text.splitlines() if line.strip()]
+
+
+def test_simulate_streams_and_estimate_ramp_through_hopf():
+    # A speed ramp 480 -> 530 km/h over 30 s through the Hopf speed (517.6 km/h) on a smooth irregular track:
+    # the monitor says WATCH in the bistable band first, ALARM at the latest once the Hopf speed is passed, and
+    # never shows margins without data.
+    with tempfile.TemporaryDirectory() as d:
+        acc, spd, tbl = (os.path.join(d, n) for n in ("a.csv", "s.csv", "t.tbl"))
+        run("simulate", "--v", "480", "--v-end", "530", "--t", "30", "--irregularity", "0.01", "--dt-out", "0.0005",
+            "--accel-out", acc, "--speed-out", spd, "--accel-noise", "0.05", "--out", os.devnull)
+        with open(acc) as f:
+            head = [next(f) for _ in range(3)]
+        assert head[0].strip() == "t_s,accel_mps2" and len(open(acc).readlines()) == 60002, head
+        run("tables", "--out", tbl, "--conicity-min", "0.12", "--conicity-max", "0.16", "--n", "3")
+        out = lines(run("estimate", "--accel", acc, "--speed", spd, "--table", tbl, "--every", "0.5").stdout)
+    assert len(out) >= 55, len(out)
+    levels = [o["level"] for o in out]
+    assert levels[1] == "WATCH", levels
+    first_alarm = next(o for o in out if o["level"] == "ALARM")
+    assert first_alarm["speed_kmh"] <= 517.618 + 3.0, first_alarm  # alarmed at the latest just past Hopf
+    assert all(o["level"] == "ALARM" for o in out if o["speed_kmh"] >= 520.0), levels
+    for o in out:
+        assert all(v is None or (isinstance(v, (int, float)) and math.isfinite(v)) for v in o.values()
+                   if not isinstance(v, (str, bool))), o
+        if o["level"] != "NO_DATA":
+            assert o["margin_hopf_kmh"] is not None and o["hopf_kmh"] is not None, o
+    # the level changes carry reasons, and there are few of them (no chatter)
+    changes = [o for o in out if o["level_changed"]]
+    assert 1 <= len(changes) <= 4 and all(o["reason"] for o in changes), [(o["t_s"], o["level"]) for o in changes]
+
+
+def test_estimate_bad_and_stale_input():
+    with tempfile.TemporaryDirectory() as d:
+        acc = os.path.join(d, "a.csv")
+        tbl = os.path.join(d, "t.tbl")
+        run("tables", "--out", tbl, "--conicity-min", "0.12", "--conicity-max", "0.16", "--n", "2")
+        with open(acc, "w") as f:
+            f.write("t_s,accel_mps2\n")
+            for i in range(6000):
+                t = i / 2000
+                if 2000 <= i < 3000:
+                    continue  # a 0.5 s dropout
+                value = "nan" if i % 997 == 0 else "%.6f" % (2.0 * math.sin(2 * math.pi * 14 * t))
+                f.write(f"{t:.4f},{value}\n")
+        out = lines(run("estimate", "--accel", acc, "--v", "400", "--table", tbl, "--every", "0.25").stdout)
+        assert out[-1]["rejected_samples"] == 6 and out[-1]["gaps"] == 1, out[-1]
+        assert all(o["level"] != "NO_DATA" for o in out), [o["level"] for o in out]
+        bad = os.path.join(d, "bad.csv")
+        with open(bad, "w") as f:
+            f.write("time,accel\n0,1\n")
+        p = run("estimate", "--accel", bad, "--v", "400", "--table", tbl, ok=False)
+        assert p.returncode != 0 and "the header must be 't_s,accel_mps2'" in p.stderr, p.stderr
+        p = run("estimate", "--accel", acc, "--table", tbl, ok=False)
+        assert p.returncode != 0 and "exactly one of --speed FILE or --v" in p.stderr, p.stderr
+        mon = os.path.join(d, "m.yaml")
+        with open(mon, "w") as f:
+            f.write("estimator:\n  rms_limit: 3\n")
+        p = run("estimate", "--accel", acc, "--v", "400", "--table", tbl, "--monitor", mon, ok=False)
+        assert p.returncode != 0 and "estimator.rms_limit: unknown key" in p.stderr, p.stderr
 
 
 def main():
