@@ -80,6 +80,9 @@ typedef struct {
 /* Boundaries at (conicity, speed). No allocation. HM_EDOMAIN for non-finite input. */
 hm_status hm_table_lookup(const hm_table t, double conicity, double speed_kmh, hm_table_lookup_result *out);
 
+/* The stiffnesses [MN/m] of the vehicle the table was made for (a user checks them against its vehicle). */
+void hm_table_vehicle(const hm_table t, double *kx_mn_m, double *ky_mn_m);
+
 /* Number of conicities and the range, for reporting. */
 size_t hm_table_size(const hm_table t, double *conicity_min, double *conicity_max);
 

@@ -163,6 +163,11 @@ hm_status hm_table_lookup(const hm_table t, double conicity, double speed_kmh, h
   return HM_OK;
 }
 
+void hm_table_vehicle(const hm_table t, double *kx_mn_m, double *ky_mn_m) {
+  if (kx_mn_m) *kx_mn_m = t ? t->kx_mn_m : NAN;
+  if (ky_mn_m) *ky_mn_m = t ? t->ky_mn_m : NAN;
+}
+
 size_t hm_table_size(const hm_table t, double *conicity_min, double *conicity_max) {
   if (!t || t->n == 0) return 0;
   if (conicity_min) *conicity_min = t->curves[0].conicity;

@@ -1,0 +1,266 @@
+#include "monitor_ros.h"
+
+#include <hunting_monitor/HuntingStatus.h>
+#include <std_msgs/UInt8.h>
+#include <visualization_msgs/MarkerArray.h>
+
+#include <cmath>
+#include <cstdio>
+
+#include "yaml_params.h"
+
+extern "C" {
+#include "hunting_monitor/config.h"
+}
+
+namespace hunting_monitor {
+
+namespace {
+// A NaN never goes out: unknown quantities are 0 with their *_valid flag false.
+double finite(double x) { return std::isfinite(x) ? x : 0.0; }
+}  // namespace
+
+MonitorRos::MonitorRos(ros::NodeHandle nh, ros::NodeHandle pnh) : nh_(nh), pnh_(pnh), updater_(nh, pnh) {
+  if (!loadParameters()) return;
+  est_ = hm_estimator_create(&est_cfg_, &vehicle_);
+  alarm_ = hm_alarm_create(&alarm_cfg_, table_);
+  if (!est_ || !alarm_) {
+    ROS_FATAL("hunting_monitor: cannot create the estimator or the alarm (out of memory)");
+    return;
+  }
+  if (accel_type_ == "imu")
+    accel_sub_ = nh_.subscribe("accel", 4000, &MonitorRos::onAccelImu, this, ros::TransportHints().tcpNoDelay());
+  else
+    accel_sub_ = nh_.subscribe("accel", 4000, &MonitorRos::onAccelFloat, this, ros::TransportHints().tcpNoDelay());
+  speed_sub_ = nh_.subscribe("speed", 100, &MonitorRos::onSpeed, this);
+  status_pub_ = nh_.advertise<hunting_monitor::HuntingStatus>("hunting_status", 50);
+  alarm_pub_ = nh_.advertise<std_msgs::UInt8>("hunting_alarm", 1, true);
+  marker_pub_ = nh_.advertise<visualization_msgs::MarkerArray>("hunting_markers", 5);
+  updater_.setHardwareID("hunting_monitor");
+  accel_min_hz_ = 0.9 * est_cfg_.sample_rate_hz;
+  accel_max_hz_ = 1.1 * est_cfg_.sample_rate_hz;
+  accel_freq_.reset(new diagnostic_updater::FrequencyStatus(
+      diagnostic_updater::FrequencyStatusParam(&accel_min_hz_, &accel_max_hz_, 0.0, 5)));
+  updater_.add(*accel_freq_);
+  updater_.add("inputs", this, &MonitorRos::diagnoseInputs);
+  updater_.add("hunting level", this, &MonitorRos::diagnoseLevel);
+  timer_ = nh_.createTimer(ros::Duration(1.0 / status_rate_hz_), &MonitorRos::onTimer, this);
+  ok_ = true;
+  ROS_INFO("hunting_monitor: ready (accel %s at %.0f Hz, speed in %s, status at %.1f Hz, table %s)",
+           accel_type_.c_str(), est_cfg_.sample_rate_hz, speed_unit_.c_str(), status_rate_hz_,
+           table_file_.c_str());
+}
+
+MonitorRos::~MonitorRos() {
+  hm_alarm_destroy(alarm_);
+  hm_estimator_destroy(est_);
+  hm_table_destroy(table_);
+}
+
+bool MonitorRos::loadParameters() {
+  char err[512] = "";
+  // vehicle, estimator and alarm sections go through the core's own YAML parsers
+  const std::string vehicle_yaml = sectionsAsYaml(pnh_, {"vehicle", "conicity", "flange"});
+  if (hm_config_parse_vehicle(vehicle_yaml.c_str(), vehicle_yaml.size(), "~ (vehicle parameters)", &vehicle_,
+                              nullptr, err, sizeof err) != HM_OK) {
+    ROS_FATAL("hunting_monitor: %s", err);
+    return false;
+  }
+  hm_estimator_config_default(&est_cfg_);
+  hm_alarm_config_default(&alarm_cfg_);
+  hm_conicity_eval(&vehicle_.conicity, 0.0, &alarm_cfg_.conicity_fallback, nullptr);
+  const std::string monitor_yaml = sectionsAsYaml(pnh_, {"estimator", "alarm"});
+  if (hm_config_parse_monitor(monitor_yaml.c_str(), monitor_yaml.size(), "~ (monitor parameters)", &est_cfg_,
+                              &alarm_cfg_, err, sizeof err) != HM_OK) {
+    ROS_FATAL("hunting_monitor: %s", err);
+    return false;
+  }
+  pnh_.param<std::string>("accel_type", accel_type_, "imu");
+  pnh_.param<std::string>("imu_axis", imu_axis_, "y");
+  pnh_.param<std::string>("speed_unit", speed_unit_, "kmh");
+  pnh_.param<std::string>("frame_id", frame_id_, "base_link");
+  pnh_.param<std::string>("table_file", table_file_, "");
+  pnh_.param("status_rate_hz", status_rate_hz_, 20.0);
+  if (accel_type_ != "imu" && accel_type_ != "float64") {
+    ROS_FATAL("hunting_monitor: ~accel_type must be imu or float64, got '%s'", accel_type_.c_str());
+    return false;
+  }
+  if (imu_axis_ != "x" && imu_axis_ != "y" && imu_axis_ != "z") {
+    ROS_FATAL("hunting_monitor: ~imu_axis must be x, y or z, got '%s'", imu_axis_.c_str());
+    return false;
+  }
+  if (speed_unit_ != "kmh" && speed_unit_ != "mps") {
+    ROS_FATAL("hunting_monitor: ~speed_unit must be kmh or mps, got '%s'", speed_unit_.c_str());
+    return false;
+  }
+  if (!(status_rate_hz_ > 0.0 && status_rate_hz_ <= 1000.0)) {
+    ROS_FATAL("hunting_monitor: ~status_rate_hz must be in (0, 1000], got %g", status_rate_hz_);
+    return false;
+  }
+  if (table_file_.empty()) {
+    ROS_FATAL("hunting_monitor: ~table_file is required (make one with 'hunting tables --out FILE')");
+    return false;
+  }
+  if (hm_table_load_file(table_file_.c_str(), &table_, err, sizeof err) != HM_OK) {
+    ROS_FATAL("hunting_monitor: ~table_file: %s", err);
+    return false;
+  }
+  // a table made for another vehicle would give wrong margins: its stiffnesses must be this vehicle's
+  double kx, ky;
+  hm_table_vehicle(table_, &kx, &ky);
+  const double vkx = vehicle_.stiffness_long_n_m * 1e-6, vky = vehicle_.stiffness_lat_n_m * 1e-6;
+  if (std::fabs(kx - vkx) > 1e-9 * vkx || std::fabs(ky - vky) > 1e-9 * std::fmax(vky, 1e-9)) {
+    ROS_FATAL("hunting_monitor: ~table_file %s was made for Kx %g, Ky %g MN/m but the vehicle has Kx %g, Ky %g",
+              table_file_.c_str(), kx, ky, vkx, vky);
+    return false;
+  }
+  return true;
+}
+
+void MonitorRos::pushAccel(double t, double a) {
+  if (hm_estimator_push_accel(est_, t, a) == HM_OK) accel_freq_->tick();
+}
+
+void MonitorRos::onAccelFloat(const std_msgs::Float64::ConstPtr& msg) {
+  pushAccel(ros::Time::now().toSec(), msg->data);  // receipt time: no stamp in a Float64
+}
+
+void MonitorRos::onAccelImu(const sensor_msgs::Imu::ConstPtr& msg) {
+  const auto& a = msg->linear_acceleration;
+  pushAccel(msg->header.stamp.toSec(), imu_axis_ == "x" ? a.x : imu_axis_ == "y" ? a.y : a.z);
+}
+
+void MonitorRos::onSpeed(const std_msgs::Float64::ConstPtr& msg) {
+  const double v = speed_unit_ == "mps" ? msg->data * 3.6 : msg->data;
+  hm_estimator_push_speed(est_, ros::Time::now().toSec(), v);
+}
+
+void MonitorRos::onTimer(const ros::TimerEvent&) {
+  const ros::Time now = ros::Time::now();
+  hm_estimate e;
+  hm_assessment s;
+  hm_estimator_read(est_, now.toSec(), &e);
+  if (hm_alarm_update(alarm_, &e, now.toSec(), &s) != HM_OK) return;
+  last_est_ = e;
+  last_ = s;
+  have_last_ = true;
+
+  hunting_monitor::HuntingStatus m;
+  m.header.stamp = now;
+  m.header.frame_id = frame_id_;
+  m.level = static_cast<uint8_t>(s.level);
+  m.reason_code = static_cast<uint8_t>(s.reason);
+  m.reason = hm_reason_text(s.reason);
+  m.speed_kmh = finite(e.speed_kmh);
+  m.speed_valid = e.speed_valid;
+  m.conicity_estimate = finite(e.conicity);
+  m.conicity_confidence = finite(e.conicity_confidence);
+  m.conicity_valid = e.conicity_valid;
+  m.boundaries_valid = s.boundaries_valid;  // never a stale margin presented as current
+  const hm_table_lookup_result& b = s.boundaries;
+  m.conicity_used = s.boundaries_valid ? finite(s.conicity) : 0.0;
+  m.hopf_speed_kmh = s.boundaries_valid ? finite(b.hopf_speed_kmh) : 0.0;
+  m.lower_fold_speed_kmh = s.boundaries_valid ? finite(b.lowest_cycle_speed_kmh) : 0.0;
+  m.margin_to_hopf_kmh = s.boundaries_valid ? finite(s.margin_hopf_kmh) : 0.0;
+  m.margin_to_lower_fold_kmh = s.boundaries_valid ? finite(s.margin_lowest_cycle_kmh) : 0.0;
+  m.amplitude_accel_mps2 = finite(e.amplitude_accel_mps2);
+  m.amplitude_displacement_m = finite(e.amplitude_displacement_m);
+  m.frequency_hz = finite(e.frequency_hz);
+  m.oscillation_valid = e.oscillation_valid;
+  m.cycles_valid = s.boundaries_valid && b.has_edge;
+  m.unstable_cycle_amplitude_m = m.cycles_valid ? finite(b.edge_amp_m) : 0.0;
+  m.stable_cycle_amplitude_m = s.boundaries_valid && b.has_stable_outer ? finite(b.stable_outer_amp_m) : 0.0;
+  m.rms_accel_mps2 = finite(e.rms_mps2);
+  m.consecutive_peaks = e.consecutive_peaks;
+  m.criterion_rms_exceeded = e.rms_exceeded;
+  m.criterion_peaks_exceeded = e.peaks_exceeded;
+  status_pub_.publish(m);
+
+  if (static_cast<int>(s.level) != last_published_level_) {
+    std_msgs::UInt8 level;
+    level.data = static_cast<uint8_t>(s.level);
+    alarm_pub_.publish(level);
+    last_published_level_ = static_cast<int>(s.level);
+    ROS_INFO("hunting_monitor: level %s (%s) at %.1f km/h", hm_level_name(s.level), hm_reason_text(s.reason),
+             e.speed_kmh);
+  }
+  publishMarkers(e, s, now);
+  updater_.update();
+}
+
+void MonitorRos::publishMarkers(const hm_estimate& e, const hm_assessment& s, const ros::Time& now) {
+  static const float colours[5][3] = {{0.5f, 0.5f, 0.5f}, {0.1f, 0.8f, 0.1f}, {0.9f, 0.9f, 0.1f},
+                                      {1.0f, 0.55f, 0.0f}, {0.9f, 0.1f, 0.1f}};
+  const float* c = colours[static_cast<int>(s.level)];
+  visualization_msgs::MarkerArray arr;
+  visualization_msgs::Marker lamp;
+  lamp.header.stamp = now;
+  lamp.header.frame_id = frame_id_;
+  lamp.ns = "hunting";
+  lamp.id = 0;
+  lamp.type = visualization_msgs::Marker::SPHERE;
+  lamp.action = visualization_msgs::Marker::ADD;
+  lamp.pose.orientation.w = 1.0;
+  lamp.scale.x = lamp.scale.y = lamp.scale.z = 1.0;
+  lamp.color.r = c[0];
+  lamp.color.g = c[1];
+  lamp.color.b = c[2];
+  lamp.color.a = 1.0;
+  arr.markers.push_back(lamp);
+  visualization_msgs::Marker text = lamp;
+  text.id = 1;
+  text.type = visualization_msgs::Marker::TEXT_VIEW_FACING;
+  text.pose.position.z = 1.6;
+  text.scale.x = text.scale.y = 0.0;
+  text.scale.z = 0.3;
+  text.color.r = text.color.g = text.color.b = 1.0;
+  char buf[512];
+  if (s.boundaries_valid)
+    std::snprintf(buf, sizeof buf,
+                  "%s: %s\nV %.1f km/h  Hopf %.1f (margin %.1f)  lowest cycle %.1f\n"
+                  "amplitude %.2f mm at %.1f Hz  unstable cycle %.2f mm\nconicity %.3f (%s)",
+                  hm_level_name(s.level), hm_reason_text(s.reason), e.speed_kmh, s.boundaries.hopf_speed_kmh,
+                  s.margin_hopf_kmh, s.boundaries.lowest_cycle_speed_kmh, 1e3 * e.amplitude_displacement_m,
+                  e.frequency_hz, s.boundaries.has_edge ? 1e3 * s.boundaries.edge_amp_m : 0.0, s.conicity,
+                  s.conicity_from_estimate ? "estimated" : "configured");
+  else
+    std::snprintf(buf, sizeof buf, "%s: %s", hm_level_name(s.level), hm_reason_text(s.reason));
+  text.text = buf;
+  arr.markers.push_back(text);
+  marker_pub_.publish(arr);
+}
+
+void MonitorRos::diagnoseInputs(diagnostic_updater::DiagnosticStatusWrapper& stat) {
+  const hm_estimate& e = last_est_;
+  if (!have_last_ || !e.accel_valid || !e.speed_valid)
+    stat.summary(diagnostic_msgs::DiagnosticStatus::ERROR,
+                 !have_last_ ? "no data yet" : !e.accel_valid ? "acceleration stale or missing" : "speed stale or missing");
+  else if (e.n_rejected_nonfinite + e.n_rejected_range + e.n_rejected_order + e.n_speed_rejected + e.n_gaps > 0)
+    stat.summary(diagnostic_msgs::DiagnosticStatus::WARN, "inputs current; some samples were rejected");
+  else
+    stat.summary(diagnostic_msgs::DiagnosticStatus::OK, "inputs current");
+  stat.add("speed_kmh", e.speed_kmh);
+  stat.add("samples", e.n_samples);
+  stat.add("rejected non-finite", e.n_rejected_nonfinite);
+  stat.add("rejected out of range", e.n_rejected_range);
+  stat.add("rejected out of order", e.n_rejected_order);
+  stat.add("gaps", e.n_gaps);
+  stat.add("rejected speeds", e.n_speed_rejected);
+  stat.add("oscillation valid", static_cast<bool>(e.oscillation_valid));
+  stat.add("conicity confidence", e.conicity_confidence);
+}
+
+void MonitorRos::diagnoseLevel(diagnostic_updater::DiagnosticStatusWrapper& stat) {
+  const hm_level l = have_last_ ? last_.level : HM_LEVEL_NO_DATA;
+  const unsigned char d = l == HM_LEVEL_OK || l == HM_LEVEL_WATCH ? diagnostic_msgs::DiagnosticStatus::OK
+                          : l == HM_LEVEL_WARN                       ? diagnostic_msgs::DiagnosticStatus::WARN
+                                                                     : diagnostic_msgs::DiagnosticStatus::ERROR;
+  stat.summary(d, std::string(hm_level_name(l)) + ": " + hm_reason_text(have_last_ ? last_.reason : HM_REASON_STARTUP));
+  if (have_last_ && last_.boundaries_valid) {
+    stat.add("margin to Hopf [km/h]", last_.margin_hopf_kmh);
+    stat.add("margin to lowest cycle speed [km/h]", last_.margin_lowest_cycle_kmh);
+    stat.add("conicity used", last_.conicity);
+  }
+}
+
+}  // namespace hunting_monitor

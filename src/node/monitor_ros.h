@@ -1,0 +1,70 @@
+// hunting_monitor_node: ROS plumbing around the C core's estimator and alarm (no physics or signal processing
+// here): parameters, subscriptions, message conversion, publication, diagnostics and rviz markers.
+#ifndef HUNTING_MONITOR_MONITOR_ROS_H
+#define HUNTING_MONITOR_MONITOR_ROS_H
+
+#include <diagnostic_updater/diagnostic_updater.h>
+#include <diagnostic_updater/update_functions.h>
+#include <ros/ros.h>
+#include <sensor_msgs/Imu.h>
+#include <std_msgs/Float64.h>
+
+#include <memory>
+#include <string>
+
+extern "C" {
+#include "hunting_monitor/alarm.h"
+#include "hunting_monitor/estimator.h"
+#include "hunting_monitor/model.h"
+#include "hunting_monitor/tables.h"
+}
+
+namespace hunting_monitor {
+
+class MonitorRos {
+ public:
+  // Reads and validates every parameter; on a bad one logs ROS_FATAL and leaves ok() false.
+  MonitorRos(ros::NodeHandle nh, ros::NodeHandle pnh);
+  ~MonitorRos();
+  bool ok() const { return ok_; }
+
+ private:
+  bool loadParameters();
+  void onAccelFloat(const std_msgs::Float64::ConstPtr& msg);
+  void onAccelImu(const sensor_msgs::Imu::ConstPtr& msg);
+  void onSpeed(const std_msgs::Float64::ConstPtr& msg);
+  void pushAccel(double t, double a);
+  void onTimer(const ros::TimerEvent& ev);
+  void publishMarkers(const hm_estimate& e, const hm_assessment& s, const ros::Time& now);
+  void diagnoseInputs(diagnostic_updater::DiagnosticStatusWrapper& stat);
+  void diagnoseLevel(diagnostic_updater::DiagnosticStatusWrapper& stat);
+
+  ros::NodeHandle nh_, pnh_;
+  bool ok_ = false;
+  // parameters
+  std::string accel_type_, imu_axis_, speed_unit_, frame_id_, table_file_;
+  double status_rate_hz_ = 20.0;
+  hm_vehicle vehicle_{};
+  hm_estimator_config est_cfg_{};
+  hm_alarm_config alarm_cfg_{};
+  // core objects
+  hm_table table_ = nullptr;
+  hm_estimator est_ = nullptr;
+  hm_alarm alarm_ = nullptr;
+  // last results, for diagnostics
+  hm_estimate last_est_{};
+  hm_assessment last_{};
+  bool have_last_ = false;
+  int last_published_level_ = -1;
+  // ROS
+  ros::Subscriber accel_sub_, speed_sub_;
+  ros::Publisher status_pub_, alarm_pub_, marker_pub_;
+  ros::Timer timer_;
+  diagnostic_updater::Updater updater_;
+  double accel_min_hz_ = 0.0, accel_max_hz_ = 0.0;
+  std::unique_ptr<diagnostic_updater::FrequencyStatus> accel_freq_;
+};
+
+}  // namespace hunting_monitor
+
+#endif

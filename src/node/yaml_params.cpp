@@ -1,0 +1,68 @@
+#include "yaml_params.h"
+
+#include <cstdio>
+#include <sstream>
+
+namespace hunting_monitor {
+namespace {
+
+void emit(std::ostringstream& out, XmlRpc::XmlRpcValue& v) {
+  switch (v.getType()) {
+    case XmlRpc::XmlRpcValue::TypeBoolean: out << (static_cast<bool>(v) ? "true" : "false"); break;
+    case XmlRpc::XmlRpcValue::TypeInt: out << static_cast<int>(v); break;
+    case XmlRpc::XmlRpcValue::TypeDouble: {
+      char buf[40];
+      std::snprintf(buf, sizeof buf, "%.17g", static_cast<double>(v));
+      out << buf;
+      break;
+    }
+    case XmlRpc::XmlRpcValue::TypeString: {
+      out << '"';
+      for (char c : static_cast<std::string>(v))
+        if (c != '"' && c != '\\' && static_cast<unsigned char>(c) >= 0x20) out << c;
+      out << '"';
+      break;
+    }
+    case XmlRpc::XmlRpcValue::TypeArray:
+      out << '[';
+      for (int i = 0; i < v.size(); ++i) {
+        if (i) out << ", ";
+        emit(out, v[i]);
+      }
+      out << ']';
+      break;
+    case XmlRpc::XmlRpcValue::TypeStruct: {
+      out << '{';
+      bool first = true;
+      for (auto& kv : v) {
+        if (!first) out << ", ";
+        first = false;
+        out << '"' << kv.first << "\": ";
+        emit(out, kv.second);
+      }
+      out << '}';
+      break;
+    }
+    default: out << "null"; break;
+  }
+}
+
+}  // namespace
+
+std::string sectionsAsYaml(const ros::NodeHandle& nh, const std::vector<std::string>& sections) {
+  std::ostringstream out;
+  out << '{';
+  bool first = true;
+  for (const auto& s : sections) {
+    XmlRpc::XmlRpcValue v;
+    if (!nh.getParam(s, v)) continue;
+    if (!first) out << ", ";
+    first = false;
+    out << '"' << s << "\": ";
+    emit(out, v);
+  }
+  out << "}\n";
+  return out.str();
+}
+
+}  // namespace hunting_monitor

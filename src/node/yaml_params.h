@@ -1,0 +1,18 @@
+// Thin helpers of the ROS nodes: private parameter sections turned into the YAML text the C core parses, so a
+// node validates its parameters with exactly the code and messages of the command-line tool.
+#ifndef HUNTING_MONITOR_YAML_PARAMS_H
+#define HUNTING_MONITOR_YAML_PARAMS_H
+
+#include <ros/ros.h>
+
+#include <string>
+#include <vector>
+
+namespace hunting_monitor {
+
+// {"section": <its parameters>, ...} for every listed section present under nh, as flow-style YAML (JSON).
+std::string sectionsAsYaml(const ros::NodeHandle& nh, const std::vector<std::string>& sections);
+
+}  // namespace hunting_monitor
+
+#endif
