@@ -1,0 +1,122 @@
+#!/usr/bin/python3
+"""Bag replay: level sequence and timing, margins against the offline reference (`hunting estimate`), status
+rate, diagnostics, markers and the latched alarm."""
+import bisect
+import json
+import subprocess
+import threading
+import time
+import unittest
+
+import rospy
+import rostest
+from diagnostic_msgs.msg import DiagnosticArray
+from hunting_monitor.msg import HuntingStatus
+from std_msgs.msg import UInt8
+from visualization_msgs.msg import MarkerArray
+
+T0 = 100.0       # bag time of the simulation's start (scripts/make_test_bag)
+DURATION = 30.0  # simulated seconds
+LEVELS = ["NO_DATA", "OK", "WATCH", "WARN", "ALARM"]
+
+
+class Replay(unittest.TestCase):
+    status, diagnostics, markers = [], [], []
+    reference = []
+
+    @classmethod
+    def setUpClass(cls):
+        rospy.init_node("test_replay")
+        lock = threading.Lock()
+
+        def keep(store):
+            def cb(msg):
+                with lock:
+                    store.append(msg)
+            return cb
+        rospy.Subscriber("hunting_status", HuntingStatus, keep(cls.status), queue_size=1000)
+        rospy.Subscriber("/diagnostics", DiagnosticArray, keep(cls.diagnostics), queue_size=100)
+        rospy.Subscriber("hunting_markers", MarkerArray, keep(cls.markers), queue_size=100)
+        deadline = time.time() + 120.0
+        while time.time() < deadline:
+            with lock:
+                done = cls.status and cls.status[-1].header.stamp.to_sec() >= T0 + DURATION - 0.1
+            if done:
+                break
+            time.sleep(0.2)
+        data = rospy.get_param("~data_dir")
+        out = subprocess.run([rospy.get_param("~hunting"), "estimate", "--accel", data + "/accel.csv", "--speed",
+                              data + "/speed.csv", "--table", rospy.get_param("~table"), "--every", "0.05"],
+                             capture_output=True, text=True, check=True).stdout
+        cls.reference = [json.loads(line) for line in out.splitlines() if line.strip()]
+
+    def data_statuses(self):
+        return [m for m in self.status if T0 + 1.5 <= m.header.stamp.to_sec() <= T0 + DURATION - 0.1]
+
+    def test_replay_covers_the_bag(self):
+        self.assertTrue(self.status, "no hunting_status received")
+        self.assertGreaterEqual(self.status[-1].header.stamp.to_sec(), T0 + DURATION - 0.1)
+
+    def test_level_sequence_and_timing(self):
+        seq = self.data_statuses()
+        levels = [LEVELS[m.level] for m in seq]
+        self.assertNotIn("NO_DATA", levels, "NO_DATA while data flows")
+        self.assertEqual(levels[0], "WATCH", "470 km/h is in the bistable band (lowest cycle 239.5 km/h)")
+        first_alarm = next(m for m in seq if m.level == HuntingStatus.LEVEL_ALARM)
+        # ALARM at the latest just past the Hopf speed (517.6 km/h), and it stays
+        self.assertLessEqual(first_alarm.speed_kmh, 517.618 + 3.0)
+        self.assertTrue(all(m.level == HuntingStatus.LEVEL_ALARM for m in seq if m.speed_kmh >= 520.0))
+        # the order of levels never goes back below WATCH
+        self.assertTrue(all(m.level >= HuntingStatus.LEVEL_WATCH for m in seq))
+
+    def test_margins_match_the_offline_reference(self):
+        times = [r["t_s"] for r in self.reference]
+        agree_level = agree_margin = n = 0
+        for m in self.data_statuses():
+            t = m.header.stamp.to_sec() - T0
+            i = bisect.bisect_left(times, t)
+            cand = [self.reference[j] for j in (i - 1, i) if 0 <= j < len(times)]
+            r = min(cand, key=lambda c: abs(c["t_s"] - t))
+            if abs(r["t_s"] - t) > 0.05:
+                continue
+            n += 1
+            agree_level += LEVELS[m.level] == r["level"]
+            if r["margin_hopf_kmh"] is not None and m.boundaries_valid:
+                agree_margin += abs(m.margin_to_hopf_kmh - r["margin_hopf_kmh"]) < 2.0 and \
+                    abs(m.lower_fold_speed_kmh - r["lowest_cycle_kmh"]) < 2.0
+        self.assertGreater(n, 400, "too few matched status messages")
+        self.assertGreaterEqual(agree_level / n, 0.95, f"levels agree in {agree_level}/{n}")
+        self.assertGreaterEqual(agree_margin / n, 0.90, f"margins agree in {agree_margin}/{n}")
+
+    def test_status_rate(self):
+        stamps = [m.header.stamp.to_sec() for m in self.data_statuses()]
+        rate = (len(stamps) - 1) / (stamps[-1] - stamps[0])
+        self.assertAlmostEqual(rate, 20.0, delta=1.0)
+        for m in self.status:  # never a NaN
+            for f in ("speed_kmh", "margin_to_hopf_kmh", "amplitude_displacement_m", "frequency_hz",
+                      "conicity_estimate", "rms_accel_mps2"):
+                v = getattr(m, f)
+                self.assertTrue(v == v and abs(v) != float("inf"), f"{f} = {v}")
+
+    def test_diagnostics_and_markers(self):
+        names = {s.name for a in self.diagnostics for s in a.status}
+        self.assertTrue(any("hunting level" in n for n in names), names)
+        self.assertTrue(any("inputs" in n for n in names), names)
+        levels = {s.level for a in self.diagnostics for s in a.status if "hunting level" in s.name}
+        self.assertIn(2, levels, "ALARM maps to diagnostic ERROR")
+        self.assertTrue(self.markers and len(self.markers[-1].markers) == 2)
+        self.assertEqual(self.markers[-1].markers[0].header.frame_id, "base_link")
+
+    def test_alarm_is_latched(self):
+        got = []
+        sub = rospy.Subscriber("hunting_alarm", UInt8, lambda m: got.append(m.data))
+        deadline = time.time() + 5.0
+        while not got and time.time() < deadline:
+            time.sleep(0.05)
+        sub.unregister()
+        self.assertTrue(got, "no latched level on hunting_alarm")
+        self.assertEqual(got[0], self.status[-1].level)
+
+
+if __name__ == "__main__":
+    rostest.rosrun("hunting_monitor", "replay", Replay)

@@ -1,0 +1,128 @@
+#!/usr/bin/python3
+"""The node stays up and reports bad input (NaN, out-of-order stamps, silence) and exits with a clear message on
+bad parameters."""
+import math
+import subprocess
+import threading
+import time
+import unittest
+
+import roslib.packages
+import rospy
+import rostest
+import yaml
+from diagnostic_msgs.msg import DiagnosticArray
+from hunting_monitor.msg import HuntingStatus
+from sensor_msgs.msg import Imu
+from std_msgs.msg import Float64
+
+
+class Robustness(unittest.TestCase):
+    @classmethod
+    def setUpClass(cls):
+        rospy.init_node("test_robustness")
+        cls.lock = threading.Lock()
+        cls.status, cls.diag = [], []
+        rospy.Subscriber("hunting_status", HuntingStatus, cls.keep(cls.status), queue_size=1000)
+        rospy.Subscriber("/diagnostics", DiagnosticArray, cls.keep(cls.diag), queue_size=100)
+        cls.accel = rospy.Publisher("accel", Imu, queue_size=1000)
+        cls.speed = rospy.Publisher("speed", Float64, queue_size=10)
+        time.sleep(2.0)  # connections
+
+    @classmethod
+    def keep(cls, store):
+        def cb(msg):
+            with cls.lock:
+                store.append(msg)
+        return cb
+
+    def stream(self, seconds, value=None, stamp_offset=0.0, speed=400.0):
+        """Publish lateral acceleration at 500 Hz (a 14 Hz sine, or `value`) and speed at 10 Hz, in real time."""
+        start = time.time()
+        k = 0
+        while time.time() - start < seconds:
+            now = rospy.Time.now()
+            m = Imu()
+            m.header.stamp = now + rospy.Duration(stamp_offset)
+            m.linear_acceleration.y = 2.0 * math.sin(2 * math.pi * 14.0 * now.to_sec()) if value is None else value
+            self.accel.publish(m)
+            if k % 50 == 0:
+                self.speed.publish(Float64(speed))
+            k += 1
+            time.sleep(0.002)
+
+    def latest(self, after):
+        with self.lock:
+            return [m for m in self.status if m.header.stamp.to_sec() > after]
+
+    def diag_level(self, name, after):
+        with self.lock:
+            hits = [s for a in self.diag if a.header.stamp.to_sec() > after for s in a.status if name in s.name]
+        return hits[-1] if hits else None
+
+    def test_1_good_data_then_nan_and_out_of_order(self):
+        self.stream(3.0)
+        t = rospy.Time.now().to_sec()
+        self.stream(1.0)
+        good = self.latest(t)
+        self.assertTrue(good and good[-1].level == HuntingStatus.LEVEL_WATCH, [m.level for m in good])
+        t = rospy.Time.now().to_sec()
+        self.stream(1.0, value=float("nan"))
+        self.stream(1.0, stamp_offset=-10.0)  # stamps from the past: out of order
+        self.stream(0.5)
+        after = self.latest(t)
+        self.assertTrue(after, "the node stopped publishing")
+        for m in after:
+            self.assertTrue(all(math.isfinite(getattr(m, f)) for f in ("amplitude_accel_mps2", "frequency_hz",
+                                                                      "margin_to_hopf_kmh", "rms_accel_mps2")))
+        d = self.diag_level("inputs", t)
+        self.assertIsNotNone(d)
+        self.assertIn(d.level, (1, 2), "rejected samples must show in the diagnostics")
+        values = {kv.key: kv.value for kv in d.values}
+        self.assertGreater(int(values["rejected non-finite"]), 100)
+        self.assertGreater(int(values["rejected out of order"]), 100)
+
+    def test_2_silence_is_no_data(self):
+        self.stream(2.0)
+        t = rospy.Time.now().to_sec()
+        time.sleep(1.5)  # no acceleration, no speed
+        silent = self.latest(t + 0.5)
+        self.assertTrue(silent, "the node stopped publishing during the silence")
+        self.assertTrue(all(m.level == HuntingStatus.LEVEL_NO_DATA and not m.boundaries_valid for m in silent),
+                        [(m.level, m.boundaries_valid) for m in silent])
+        d = self.diag_level("hunting level", t + 0.5)
+        self.assertIsNotNone(d)
+        self.assertEqual(d.level, 2)
+        t = rospy.Time.now().to_sec()
+        self.stream(2.0)
+        back = self.latest(t + 1.0)
+        self.assertTrue(back and back[-1].level == HuntingStatus.LEVEL_WATCH, "the node did not recover")
+
+    def run_bad_node(self, name, vehicle_changes, extra):
+        with open(rospy.get_param("~vehicle_config")) as f:
+            params = yaml.safe_load(f)
+        for section, key, value in vehicle_changes:
+            params[section][key] = value
+        for section, value in params.items():
+            rospy.set_param(f"/{name}/{section}", value)
+        rospy.set_param(f"/{name}/table_file", rospy.get_param("~table"))
+        node = roslib.packages.find_node("hunting_monitor", "hunting_monitor_node")[0]
+        p = subprocess.run([node, f"__name:={name}"] + extra, capture_output=True, text=True, timeout=30)
+        return p.returncode, p.stdout + p.stderr
+
+    def test_3_bad_parameters_exit_with_a_message(self):
+        cases = [
+            ("bad_rate", [], ["_status_rate_hz:=-1"], "~status_rate_hz must be in (0, 1000]"),
+            ("bad_mass", [("vehicle", "mass_kg", -1869)], [], "vehicle.mass_kg: must be > 0"),
+            ("bad_type", [], ["_accel_type:=twist"], "~accel_type must be imu or float64"),
+            ("bad_table", [("vehicle", "kx_mn_m", 9.7)], [], "was made for Kx 8.96"),
+            ("bad_key", [("vehicle", "mas_kg", 1)], [], "vehicle.mas_kg: unknown key"),
+        ]
+        for name, changes, extra, message in cases:
+            code, out = self.run_bad_node(name, changes, extra)
+            self.assertNotEqual(code, 0, f"{name} exited 0")
+            self.assertIn(message, out, f"{name}: {out}")
+
+
+if __name__ == "__main__":
+    rostest.rosrun("hunting_monitor", "robustness", Robustness)
