@@ -148,6 +148,7 @@ void MonitorRos::onTimer(const ros::TimerEvent&) {
   hunting_monitor::HuntingStatus m;
   m.header.stamp = now;
   m.header.frame_id = frame_id_;
+  if (e.n_samples > 0) m.accel_stamp = ros::Time(e.time_s);
   m.level = static_cast<uint8_t>(s.level);
   m.reason_code = static_cast<uint8_t>(s.reason);
   m.reason = hm_reason_text(s.reason);
