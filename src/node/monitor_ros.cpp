@@ -97,9 +97,23 @@ bool MonitorRos::loadParameters() {
     ROS_FATAL("hunting_monitor: ~status_rate_hz must be in (0, 1000], got %g", status_rate_hz_);
     return false;
   }
-  if (table_file_.empty()) {
-    ROS_FATAL("hunting_monitor: ~table_file is required (make one with 'hunting tables --out FILE')");
-    return false;
+  if (table_file_.empty()) {  // compute on start (seconds); a file made with `hunting tables` starts at once
+    hm_table_spec spec;
+    hm_table_spec_default(&spec);
+    pnh_.param("table_conicity_min", spec.conicity_min, spec.conicity_min);
+    pnh_.param("table_conicity_max", spec.conicity_max, spec.conicity_max);
+    int n = static_cast<int>(spec.n_conicity);
+    pnh_.param("table_n", n, 8);
+    spec.n_conicity = n > 0 ? static_cast<size_t>(n) : 0;
+    ROS_INFO("hunting_monitor: no ~table_file: computing the boundary tables (%d conicities)...", n);
+    const hm_status st = hm_table_build(&vehicle_, &spec, &table_);
+    if (st != HM_OK) {
+      ROS_FATAL("hunting_monitor: computing the boundary tables failed: %s (check ~table_conicity_min/max, ~table_n)",
+                hm_status_str(st));
+      return false;
+    }
+    table_file_ = "(computed on start)";
+    return true;
   }
   if (hm_table_load_file(table_file_.c_str(), &table_, err, sizeof err) != HM_OK) {
     ROS_FATAL("hunting_monitor: ~table_file: %s", err);
@@ -213,7 +227,7 @@ void MonitorRos::publishMarkers(const hm_estimate& e, const hm_assessment& s, co
   text.type = visualization_msgs::Marker::TEXT_VIEW_FACING;
   text.pose.position.z = 1.6;
   text.scale.x = text.scale.y = 0.0;
-  text.scale.z = 0.3;
+  text.scale.z = 0.16;
   text.color.r = text.color.g = text.color.b = 1.0;
   char buf[512];
   if (s.boundaries_valid)
