@@ -188,22 +188,29 @@ static hm_status parse_document(parse_ctx *c, hm_vehicle *veh, char *name) {
   return st;
 }
 
+/* Parse text into doc (c->doc points at it); a syntax error is reported with its line. */
+static hm_status load_document(parse_ctx *c, const char *text, size_t len, yaml_document_t *doc) {
+  yaml_parser_t parser;
+  if (!yaml_parser_initialize(&parser)) return fail(c, NULL, HM_ENOMEM, "cannot initialise the YAML parser");
+  yaml_parser_set_input_string(&parser, (const unsigned char *)text, len);
+  const int loaded = yaml_parser_load(&parser, doc);
+  hm_status st = HM_OK;
+  if (!loaded)
+    st = fail(c, NULL, HM_EPARSE, "line %lu: YAML syntax error: %s", (unsigned long)parser.problem_mark.line + 1,
+              parser.problem ? parser.problem : "unknown");
+  yaml_parser_delete(&parser); /* the document does not refer to the parser */
+  if (st == HM_OK) c->doc = doc;
+  return st;
+}
+
 hm_status hm_config_parse_vehicle(const char *text, size_t len, const char *source, hm_vehicle *veh, char *name,
                                   char *err, size_t err_len) {
   if (!source) source = "<config>";
   parse_ctx c = {NULL, source, err, err_len};
   if (!text || !veh) return fail(&c, NULL, HM_EINVAL, "no text or no output");
-  yaml_parser_t parser;
   yaml_document_t doc;
-  if (!yaml_parser_initialize(&parser)) return fail(&c, NULL, HM_ENOMEM, "cannot initialise the YAML parser");
-  yaml_parser_set_input_string(&parser, (const unsigned char *)text, len);
-  if (!yaml_parser_load(&parser, &doc)) {
-    hm_status st = fail(&c, NULL, HM_EPARSE, "line %lu: YAML syntax error: %s",
-                        (unsigned long)parser.problem_mark.line + 1, parser.problem ? parser.problem : "unknown");
-    yaml_parser_delete(&parser);
-    return st;
-  }
-  c.doc = &doc;
+  hm_status st0 = load_document(&c, text, len, &doc);
+  if (st0 != HM_OK) return st0;
   hm_vehicle out;
   hm_vehicle_default(&out);
   char out_name[HM_VEHICLE_NAME_MAX];
@@ -214,7 +221,6 @@ hm_status hm_config_parse_vehicle(const char *text, size_t len, const char *sour
     if (st != HM_OK) fail(&c, NULL, st, "%s", why);
   }
   yaml_document_delete(&doc);
-  yaml_parser_delete(&parser);
   if (st != HM_OK) return st;
   *veh = out;
   if (name) memcpy(name, out_name, HM_VEHICLE_NAME_MAX);
@@ -333,17 +339,9 @@ hm_status hm_config_parse_monitor(const char *text, size_t len, const char *sour
   if (!source) source = "<config>";
   parse_ctx c = {NULL, source, err, err_len};
   if (!text || !est || !alarm) return fail(&c, NULL, HM_EINVAL, "no text or no output");
-  yaml_parser_t parser;
   yaml_document_t doc;
-  if (!yaml_parser_initialize(&parser)) return fail(&c, NULL, HM_ENOMEM, "cannot initialise the YAML parser");
-  yaml_parser_set_input_string(&parser, (const unsigned char *)text, len);
-  if (!yaml_parser_load(&parser, &doc)) {
-    hm_status st = fail(&c, NULL, HM_EPARSE, "line %lu: YAML syntax error: %s",
-                        (unsigned long)parser.problem_mark.line + 1, parser.problem ? parser.problem : "unknown");
-    yaml_parser_delete(&parser);
-    return st;
-  }
-  c.doc = &doc;
+  hm_status st0 = load_document(&c, text, len, &doc);
+  if (st0 != HM_OK) return st0;
   hm_estimator_config e = *est;
   hm_alarm_config a = *alarm;
   hm_status st = HM_OK;
@@ -359,7 +357,6 @@ hm_status hm_config_parse_monitor(const char *text, size_t len, const char *sour
     fail(&c, NULL, st, "estimator.%s", why);
   if (st == HM_OK && (st = hm_alarm_config_validate(&a, why, sizeof why)) != HM_OK) fail(&c, NULL, st, "alarm.%s", why);
   yaml_document_delete(&doc);
-  yaml_parser_delete(&parser);
   if (st != HM_OK) return st;
   *est = e;
   *alarm = a;

@@ -1,6 +1,7 @@
 /* Alarm levels: thresholds from the boundary table, hysteresis, hold time, NO_DATA, reasons. */
 #include <string.h>
 
+#include "hm_fixtures.h"
 #include "hm_test.h"
 #include "hunting_monitor/alarm.h"
 #include "hunting_monitor/linear.h"
@@ -147,14 +148,7 @@ static void bad_configuration_and_input(void) {
 }
 
 int main(void) {
-  hm_vehicle v;
-  hm_vehicle_default(&v);
-  hm_table_spec spec;
-  hm_table_spec_default(&spec);
-  spec.conicity_min = 0.12;
-  spec.conicity_max = 0.16;
-  spec.n_conicity = 3;
-  if (hm_table_build(&v, &spec, &table) != HM_OK) {
+  if (hm_test_small_table(&table) != HM_OK) {
     printf("FAIL table_build\n");
     return 1;
   }

@@ -3,6 +3,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "hm_fixtures.h"
 #include "hm_test.h"
 #include "hunting_monitor/alarm.h"
 #include "hunting_monitor/cycles.h"
@@ -170,12 +171,7 @@ int main(void) {
   hm_vehicle_default(&vehicle);
   hm_irregularity_generate(&track, 200, 3.0, 120.0, 0.01, 42);
   hm_irregularity_generate(&rough, 200, 3.0, 120.0, 1.0, 42);
-  hm_table_spec spec;
-  hm_table_spec_default(&spec);
-  spec.conicity_min = 0.12;
-  spec.conicity_max = 0.16;
-  spec.n_conicity = 3;
-  if (hm_table_build(&vehicle, &spec, &table) != HM_OK) {
+  if (hm_test_small_table(&table) != HM_OK) {
     printf("FAIL table_build\n");
     return 1;
   }

@@ -2,6 +2,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "hm_fixtures.h"
 #include "hm_test.h"
 #include "hunting_monitor/cycles.h"
 #include "hunting_monitor/linear.h"
@@ -129,12 +130,7 @@ static void malformed_tables(void) {
 
 int main(void) {
   hm_vehicle_default(&vehicle);
-  hm_table_spec spec;
-  hm_table_spec_default(&spec);
-  spec.conicity_min = 0.12;
-  spec.conicity_max = 0.16;
-  spec.n_conicity = 3;
-  if (hm_table_build(&vehicle, &spec, &table) != HM_OK) {
+  if (hm_test_small_table(&table) != HM_OK) {
     printf("FAIL table_build\n");
     return 1;
   }
