@@ -107,8 +107,8 @@ static double bench_lpc_curve(double *cusp_kx, size_t *n_points) {
   return dt;
 }
 
-/* A boundary table of 3 conicities (built once, not timed): parse time and lookup time. */
-static void bench_table(double *parse_us, double *lookup_ns, size_t *bytes) {
+/* The boundary table of the default vehicle over lambda(0) 0.12..0.16 (3 conicities), or NULL. */
+static hm_table small_table(void) {
   hm_vehicle v;
   hm_vehicle_default(&v);
   hm_table_spec spec;
@@ -117,8 +117,14 @@ static void bench_table(double *parse_us, double *lookup_ns, size_t *bytes) {
   spec.conicity_max = 0.16;
   spec.n_conicity = 3;
   hm_table t = NULL;
+  return hm_table_build(&v, &spec, &t) == HM_OK ? t : NULL;
+}
+
+/* A boundary table of 3 conicities (built once, not timed): parse time and lookup time. */
+static void bench_table(double *parse_us, double *lookup_ns, size_t *bytes) {
   *parse_us = *lookup_ns = -1.0;
-  if (hm_table_build(&v, &spec, &t) != HM_OK) return;
+  hm_table t = small_table();
+  if (!t) return;
   size_t need = 0;
   hm_table_format(t, NULL, 0, &need);
   char *buf = malloc(need);
@@ -185,14 +191,9 @@ static void bench_monitor(double *ns_push, double *ns_push_update, double *ns_re
   hm_estimator_config_default(&ec);
   hm_alarm_config ac;
   hm_alarm_config_default(&ac);
-  hm_table_spec spec;
-  hm_table_spec_default(&spec);
-  spec.conicity_min = 0.12;
-  spec.conicity_max = 0.16;
-  spec.n_conicity = 3;
-  hm_table t = NULL;
   *ns_push = *ns_push_update = *ns_read_update = -1.0;
-  if (hm_table_build(&v, &spec, &t) != HM_OK) return;
+  hm_table t = small_table();
+  if (!t) return;
   hm_estimator e = hm_estimator_create(&ec, &v);
   hm_alarm a = hm_alarm_create(&ac, t);
   const long n = 2000L * 600; /* 10 minutes of data */
