@@ -98,6 +98,42 @@ class Robustness(unittest.TestCase):
         back = self.latest(t + 1.0)
         self.assertTrue(back and back[-1].level == HuntingStatus.LEVEL_WATCH, "the node did not recover")
 
+    def test_4_float64_accel_and_speed_in_mps(self):
+        """A second node with accel_type float64 (receipt time) and speed in m/s, on its own topics."""
+        with open(rospy.get_param("~vehicle_config")) as f:
+            params = yaml.safe_load(f)
+        for section, value in params.items():
+            rospy.set_param(f"/plain/{section}", value)
+        rospy.set_param("/plain/estimator", {"sample_rate_hz": 200})
+        rospy.set_param("/plain/table_file", rospy.get_param("~table"))
+        node = roslib.packages.find_node("hunting_monitor", "hunting_monitor_node")[0]
+        proc = subprocess.Popen([node, "__name:=plain", "_accel_type:=float64", "_speed_unit:=mps",
+                                 "accel:=plain_accel", "speed:=plain_speed", "hunting_status:=plain_status"],
+                                stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+        got = []
+        sub = rospy.Subscriber("plain_status", HuntingStatus, lambda m: got.append(m), queue_size=100)
+        acc = rospy.Publisher("plain_accel", Float64, queue_size=100)
+        spd = rospy.Publisher("plain_speed", Float64, queue_size=10)
+        try:
+            time.sleep(2.0)
+            start = time.time()
+            k = 0
+            while time.time() - start < 4.0:
+                acc.publish(Float64(2.0 * math.sin(2 * math.pi * 10.0 * (time.time() - start))))
+                if k % 20 == 0:
+                    spd.publish(Float64(100.0))  # m/s = 360 km/h
+                k += 1
+                time.sleep(0.005)
+            self.assertTrue(got, "no status from the float64/m/s node")
+            last = got[-1]
+            self.assertAlmostEqual(last.speed_kmh, 360.0, places=6)
+            self.assertEqual(last.level, HuntingStatus.LEVEL_WATCH, (last.level, last.reason))
+            self.assertTrue(last.oscillation_valid and abs(last.frequency_hz - 10.0) < 0.3, last.frequency_hz)
+        finally:
+            sub.unregister()
+            proc.terminate()
+            proc.wait(timeout=10)
+
     def run_bad_node(self, name, vehicle_changes, extra):
         with open(rospy.get_param("~vehicle_config")) as f:
             params = yaml.safe_load(f)
