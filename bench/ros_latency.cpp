@@ -1,0 +1,63 @@
+// ros_latency: publishes sensor_msgs/Imu at 2 kHz for 20 s to hunting_monitor_node and measures, for each
+// hunting_status, how old the newest acceleration sample behind it is on arrival (the latency from an
+// acceleration message to the status that reflects it). Prints JSON. Used by bench/ros_bench (not a test).
+#include <hunting_monitor/HuntingStatus.h>
+#include <ros/ros.h>
+#include <sensor_msgs/Imu.h>
+#include <std_msgs/Float64.h>
+
+#include <algorithm>
+#include <atomic>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <thread>
+#include <vector>
+
+int main(int argc, char** argv) {
+  ros::init(argc, argv, "ros_latency");
+  ros::NodeHandle nh;
+  std::vector<double> ages;
+  std::atomic<bool> streaming{true};  // statuses after the stream ends reflect old samples by design: not counted
+  ros::Subscriber sub = nh.subscribe<hunting_monitor::HuntingStatus>(
+      "hunting_status", 100,
+      [&ages, &streaming](const hunting_monitor::HuntingStatus::ConstPtr& m) {
+        if (streaming && !m->accel_stamp.isZero()) ages.push_back((ros::Time::now() - m->accel_stamp).toSec());
+      },
+      ros::VoidConstPtr(), ros::TransportHints().tcpNoDelay());
+  ros::Publisher acc = nh.advertise<sensor_msgs::Imu>("accel", 4000);
+  ros::Publisher spd = nh.advertise<std_msgs::Float64>("speed", 10);
+  ros::AsyncSpinner spinner(1);
+  spinner.start();
+  ros::WallDuration(1.5).sleep();
+  const ros::WallTime start = ros::WallTime::now();
+  long n = 0;
+  while ((ros::WallTime::now() - start).toSec() < 20.0 && ros::ok()) {
+    const ros::WallTime due = start + ros::WallDuration(n / 2000.0);
+    while (ros::WallTime::now() < due) std::this_thread::yield();
+    sensor_msgs::Imu m;
+    m.header.stamp = ros::Time::now();
+    m.linear_acceleration.y = 2.0 * std::sin(2.0 * M_PI * 14.0 * n / 2000.0);
+    acc.publish(m);
+    if (n % 40 == 0) {
+      std_msgs::Float64 v;
+      v.data = 450.0;
+      spd.publish(v);
+    }
+    ++n;
+  }
+  streaming = false;
+  ros::WallDuration(0.3).sleep();
+  spinner.stop();
+  if (ages.size() < 40) {
+    std::printf("{\"error\": \"only %zu statuses received\"}\n", ages.size());
+    return 1;
+  }
+  std::vector<double> a(ages.begin() + 20, ages.end());
+  std::sort(a.begin(), a.end());
+  if (std::getenv("HM_LATENCY_DEBUG"))
+    for (size_t i = a.size() - 8; i < a.size(); ++i) std::fprintf(stderr, "%.3f ms\n", 1e3 * a[i]);
+  std::printf("{\"samples_published\": %ld, \"statuses\": %zu, \"latency_ms_median\": %.3f, \"latency_ms_p99\": %.3f}\n",
+              n, a.size(), 1e3 * a[a.size() / 2], 1e3 * a[static_cast<size_t>(0.99 * a.size())]);
+  return 0;
+}
