@@ -151,20 +151,6 @@ void cli_print_help(FILE *f, const char *command, const char *usage, const char 
   }
 }
 
-void json_number(FILE *f, double x) { fprintf(f, "%.12g", x); }
-
-void json_eigenvalues(FILE *f, const double re[4], const double im[4]) {
-  fputc('[', f);
-  for (int i = 0; i < 4; ++i) {
-    fprintf(f, "%s[", i ? ", " : "");
-    json_number(f, re[i]);
-    fputs(", ", f);
-    json_number(f, im[i]);
-    fputc(']', f);
-  }
-  fputc(']', f);
-}
-
 /* ---- JSON writer ---- */
 
 void jw_init(json_writer *w, FILE *f) {
@@ -334,4 +320,19 @@ int cli_read_csv(const char *path, int ncols, char header[][64], double **data, 
   *data = d;
   *n = rows;
   return 0;
+}
+
+void jw_numbers(json_writer *w, const char *key, const double *x, size_t n) {
+  jw_array(w, key);
+  for (size_t i = 0; i < n; ++i) jw_number(w, NULL, x[i]);
+  jw_end_array(w);
+}
+
+void jw_eigenvalues(json_writer *w, const char *key, const double re[4], const double im[4]) {
+  jw_array(w, key);
+  for (int i = 0; i < 4; ++i) {
+    const double pair[2] = {re[i], im[i]};
+    jw_numbers(w, NULL, pair, 2);
+  }
+  jw_end_array(w);
 }

@@ -40,9 +40,6 @@ double cli_conicity0(const hm_vehicle *veh);
 
 void cli_print_help(FILE *f, const char *command, const char *usage, const char *summary, const cli_option *opts);
 
-/* JSON helpers: a number printed with 12 significant digits. */
-void json_number(FILE *f, double x);
-void json_eigenvalues(FILE *f, const double re[4], const double im[4]);
 
 /* A small streaming JSON writer: keys are NULL inside arrays. Numbers with 12 significant digits; a
  * non-finite number is written as null (JSON has no NaN). */
@@ -61,6 +58,9 @@ void jw_number(json_writer *w, const char *key, double value);
 void jw_int(json_writer *w, const char *key, long value);
 void jw_string(json_writer *w, const char *key, const char *value);
 void jw_bool(json_writer *w, const char *key, int value);
+/* An array of n numbers; the eigenvalues as [[re, im], ...]. */
+void jw_numbers(json_writer *w, const char *key, const double *x, size_t n);
+void jw_eigenvalues(json_writer *w, const char *key, const double re[4], const double im[4]);
 /* Ends the document with a newline. */
 void jw_finish(json_writer *w);
 

@@ -54,23 +54,19 @@ static int cmd_critical(const cli_args *a) {
   if (st != HM_OK) return fail_status("critical speed", st);
   if ((st = hm_linear_hopf_omega(&veh, &omega)) != HM_OK) return fail_status("Hopf frequency", st);
   if ((st = hm_linear_eigenvalues(&veh, lambda, v_mps, re, im)) != HM_OK) return fail_status("eigenvalues", st);
-  printf("{\"v_crit_kmh\": ");
-  json_number(stdout, hm_kmh_from_mps(v_mps));
-  printf(", \"v_crit_mps\": ");
-  json_number(stdout, v_mps);
-  printf(", \"frequency_hz\": ");
-  json_number(stdout, omega / (2.0 * HM_PI));
-  printf(", \"omega_rad_s\": ");
-  json_number(stdout, omega);
-  printf(", \"conicity\": ");
-  json_number(stdout, lambda);
-  printf(", \"kx_mn_m\": ");
-  json_number(stdout, veh.stiffness_long_n_m * 1e-6);
-  printf(", \"ky_mn_m\": ");
-  json_number(stdout, veh.stiffness_lat_n_m * 1e-6);
-  printf(", \"eigenvalues\": ");
-  json_eigenvalues(stdout, re, im);
-  printf("}\n");
+  json_writer w;
+  jw_init(&w, stdout);
+  jw_object(&w, NULL);
+  jw_number(&w, "v_crit_kmh", hm_kmh_from_mps(v_mps));
+  jw_number(&w, "v_crit_mps", v_mps);
+  jw_number(&w, "frequency_hz", omega / (2.0 * HM_PI));
+  jw_number(&w, "omega_rad_s", omega);
+  jw_number(&w, "conicity", lambda);
+  jw_number(&w, "kx_mn_m", veh.stiffness_long_n_m * 1e-6);
+  jw_number(&w, "ky_mn_m", veh.stiffness_lat_n_m * 1e-6);
+  jw_eigenvalues(&w, "eigenvalues", re, im);
+  jw_end_object(&w);
+  jw_finish(&w);
   return 0;
 }
 
@@ -90,11 +86,13 @@ static int cmd_critical_conicity(const cli_args *a) {
     return 1;
   }
   if (st != HM_OK) return fail_status("critical conicity", st);
-  printf("{\"v_kmh\": ");
-  json_number(stdout, v_kmh);
-  printf(", \"conicity_crit\": ");
-  json_number(stdout, lambda_c);
-  printf("}\n");
+  json_writer w;
+  jw_init(&w, stdout);
+  jw_object(&w, NULL);
+  jw_number(&w, "v_kmh", v_kmh);
+  jw_number(&w, "conicity_crit", lambda_c);
+  jw_end_object(&w);
+  jw_finish(&w);
   return 0;
 }
 
@@ -109,13 +107,15 @@ static int cmd_eig(const cli_args *a) {
   const double lambda = cli_conicity0(&veh);
   hm_status st = hm_linear_eigenvalues(&veh, lambda, hm_mps_from_kmh(v_kmh), re, im);
   if (st != HM_OK) return fail_status("eigenvalues", st);
-  printf("{\"v_kmh\": ");
-  json_number(stdout, v_kmh);
-  printf(", \"conicity\": ");
-  json_number(stdout, lambda);
-  printf(", \"eigenvalues\": ");
-  json_eigenvalues(stdout, re, im);
-  printf(", \"stable\": %s}\n", re[0] < 0.0 ? "true" : "false");
+  json_writer w;
+  jw_init(&w, stdout);
+  jw_object(&w, NULL);
+  jw_number(&w, "v_kmh", v_kmh);
+  jw_number(&w, "conicity", lambda);
+  jw_eigenvalues(&w, "eigenvalues", re, im);
+  jw_bool(&w, "stable", re[0] < 0.0);
+  jw_end_object(&w);
+  jw_finish(&w);
   return 0;
 }
 
@@ -310,29 +310,18 @@ static int cmd_lyapunov(const cli_args *a) {
     return 1;
   }
   if (st != HM_OK) return fail_status("Lyapunov spectrum", st);
-  printf("{\"v_kmh\": ");
-  json_number(stdout, v_kmh);
-  printf(", \"model\": \"%s\", \"method\": \"%s\", \"exponents\": [", linear ? "linear" : "nonlinear",
-         opt.method == HM_LYAP_DOPRI ? "dopri" : "midpoint");
-  for (int i = 0; i < 4; ++i) {
-    if (i) printf(", ");
-    json_number(stdout, exps[i]);
-  }
-  printf("], \"x_end\": [");
-  for (int i = 0; i < 4; ++i) {
-    if (i) printf(", ");
-    json_number(stdout, x_end[i]);
-  }
-  printf("]");
-  if (linear && hm_linear_eigenvalues(&veh, cli_conicity0(&veh), model.speed_mps, re, im) == HM_OK) {
-    printf(", \"eigenvalue_real_parts\": [");
-    for (int i = 0; i < 4; ++i) {
-      if (i) printf(", ");
-      json_number(stdout, re[i]);
-    }
-    printf("]");
-  }
-  printf("}\n");
+  json_writer w;
+  jw_init(&w, stdout);
+  jw_object(&w, NULL);
+  jw_number(&w, "v_kmh", v_kmh);
+  jw_string(&w, "model", linear ? "linear" : "nonlinear");
+  jw_string(&w, "method", opt.method == HM_LYAP_DOPRI ? "dopri" : "midpoint");
+  jw_numbers(&w, "exponents", exps, 4);
+  jw_numbers(&w, "x_end", x_end, 4);
+  if (linear && hm_linear_eigenvalues(&veh, cli_conicity0(&veh), model.speed_mps, re, im) == HM_OK)
+    jw_numbers(&w, "eigenvalue_real_parts", re, 4);
+  jw_end_object(&w);
+  jw_finish(&w);
   return 0;
 }
 
@@ -360,14 +349,19 @@ static int cmd_sweep(const cli_args *a) {
   hm_status st = hm_linear_hopf_omega(&veh, &omega);
   if (st != HM_OK) return fail_status("Hopf frequency", st);
   const int n = (int)n_d, table = cli_has(a, "table");
+  json_writer w;
+  jw_init(&w, stdout);
   if (table) {
     printf("Linear critical (Hopf) speed of the wheelset vs equivalent conicity\n");
     printf("vehicle %s: Kx = %.2f MN/m, Ky = %.2f MN/m; hunting frequency at criticality %.3f Hz\n\n", name,
            veh.stiffness_long_n_m * 1e-6, veh.stiffness_lat_n_m * 1e-6, omega / (2.0 * HM_PI));
     printf("  conicity   critical speed [km/h]\n");
   } else {
-    printf("{\"kx_mn_m\": %.12g, \"ky_mn_m\": %.12g, \"frequency_hz\": %.12g, \"rows\": [",
-           veh.stiffness_long_n_m * 1e-6, veh.stiffness_lat_n_m * 1e-6, omega / (2.0 * HM_PI));
+    jw_object(&w, NULL);
+    jw_number(&w, "kx_mn_m", veh.stiffness_long_n_m * 1e-6);
+    jw_number(&w, "ky_mn_m", veh.stiffness_lat_n_m * 1e-6);
+    jw_number(&w, "frequency_hz", omega / (2.0 * HM_PI));
+    jw_array(&w, "rows");
   }
   for (int i = 0; i < n; ++i) {
     const double lambda = n == 1 ? from : from + (to - from) * i / (n - 1);
@@ -380,15 +374,17 @@ static int cmd_sweep(const cli_args *a) {
       else
         printf("  %8.4f   %10s\n", lambda, "none");
     } else {
-      printf("%s{\"conicity\": %.12g, \"v_crit_kmh\": ", i ? ", " : "", lambda);
-      if (st == HM_OK)
-        json_number(stdout, hm_kmh_from_mps(v_mps));
-      else
-        printf("null");
-      printf("}");
+      jw_object(&w, NULL);
+      jw_number(&w, "conicity", lambda);
+      jw_number(&w, "v_crit_kmh", st == HM_OK ? hm_kmh_from_mps(v_mps) : NAN); /* null: no critical speed */
+      jw_end_object(&w);
     }
   }
-  if (!table) printf("]}\n");
+  if (!table) {
+    jw_end_array(&w);
+    jw_end_object(&w);
+    jw_finish(&w);
+  }
   return 0;
 }
 
