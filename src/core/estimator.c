@@ -488,8 +488,7 @@ void hm_estimator_read(const hm_estimator e, double now, hm_estimate *out) {
   const double w = 2.0 * HM_PI * r.frequency_hz;
   r.amplitude_displacement_m = r.oscillation_valid ? r.amplitude_accel_mps2 / (w * w) : 0.0;
   r.rms_mps2 = e->ring_n ? sqrt(fmax(e->ring_sum, 0.0) / (double)e->ring_n) : 0.0;
-  r.rms_window_complete = e->ring_dist >= c->rms_window_m * (1.0 - 1e-9) ||
-                          (e->ring_n > 1 && e->ring_dist + 1e-12 >= c->rms_window_m);
+  r.rms_window_complete = e->ring_dist >= c->rms_window_m * (1.0 - 1e-9); /* rounding of the running sum */
   r.rms_exceeded = r.rms_window_complete && r.rms_mps2 >= c->rms_limit_mps2;
   r.consecutive_peaks = e->consecutive;
   r.peaks_exceeded = e->consecutive >= c->peaks_count;

@@ -60,10 +60,9 @@ MonitorRos::~MonitorRos() {
 bool MonitorRos::loadParameters() {
   char err[512] = "";
   // vehicle, estimator and alarm sections go through the core's own YAML parsers
-  const std::string vehicle_yaml = sectionsAsYaml(pnh_, {"vehicle", "conicity", "flange"});
-  if (hm_config_parse_vehicle(vehicle_yaml.c_str(), vehicle_yaml.size(), "~ (vehicle parameters)", &vehicle_,
-                              nullptr, err, sizeof err) != HM_OK) {
-    ROS_FATAL("hunting_monitor: %s", err);
+  std::string error;
+  if (!loadVehicleParams(pnh_, &vehicle_, &error)) {
+    ROS_FATAL("hunting_monitor: %s", error.c_str());
     return false;
   }
   hm_estimator_config_default(&est_cfg_);

@@ -11,7 +11,6 @@
 #include "yaml_params.h"
 
 extern "C" {
-#include "hunting_monitor/config.h"
 #include "hunting_monitor/excitation.h"
 #include "hunting_monitor/integrate.h"
 }
@@ -61,11 +60,9 @@ int main(int argc, char** argv) {
   ros::init(argc, argv, "hunting_sim");
   ros::NodeHandle nh, pnh("~");
   hm_vehicle veh;
-  char err[512] = "";
-  const std::string yaml = hunting_monitor::sectionsAsYaml(pnh, {"vehicle", "conicity", "flange"});
-  if (hm_config_parse_vehicle(yaml.c_str(), yaml.size(), "~ (vehicle parameters)", &veh, nullptr, err, sizeof err) !=
-      HM_OK) {
-    ROS_FATAL("hunting_sim: %s", err);
+  std::string error;
+  if (!hunting_monitor::loadVehicleParams(pnh, &veh, &error)) {
+    ROS_FATAL("hunting_sim: %s", error.c_str());
     return 1;
   }
   double v_start, v_end, ramp_s, hold_s, scale, rate, noise;

@@ -3,6 +3,10 @@
 #include <cstdio>
 #include <sstream>
 
+extern "C" {
+#include "hunting_monitor/config.h"
+}
+
 namespace hunting_monitor {
 namespace {
 
@@ -63,6 +67,16 @@ std::string sectionsAsYaml(const ros::NodeHandle& nh, const std::vector<std::str
   }
   out << "}\n";
   return out.str();
+}
+
+bool loadVehicleParams(const ros::NodeHandle& nh, hm_vehicle* vehicle, std::string* error) {
+  const std::string yaml = sectionsAsYaml(nh, {"vehicle", "conicity", "flange"});
+  char err[512] = "";
+  if (hm_config_parse_vehicle(yaml.c_str(), yaml.size(), "~ (vehicle parameters)", vehicle, nullptr, err,
+                              sizeof err) == HM_OK)
+    return true;
+  *error = err;
+  return false;
 }
 
 }  // namespace hunting_monitor

@@ -8,10 +8,18 @@
 #include <string>
 #include <vector>
 
+extern "C" {
+#include "hunting_monitor/model.h"
+}
+
 namespace hunting_monitor {
 
 // {"section": <its parameters>, ...} for every listed section present under nh, as flow-style YAML (JSON).
 std::string sectionsAsYaml(const ros::NodeHandle& nh, const std::vector<std::string>& sections);
+
+// The vehicle from the private sections vehicle, conicity and flange, validated by the core's config parser.
+// On failure returns false with the parser's message in *error.
+bool loadVehicleParams(const ros::NodeHandle& nh, hm_vehicle* vehicle, std::string* error);
 
 }  // namespace hunting_monitor
 
