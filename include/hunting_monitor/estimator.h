@@ -42,6 +42,11 @@
 extern "C" {
 #endif
 
+/* Upper bounds of the settings that size the estimator's buffers: at 5 kHz the r.m.s. ring then holds at most
+ * 5000 x 1000 m / (30 km/h) = 600,000 samples (9.6 MB), the crossing ring 20 x 2 x band_high_hz crossings. */
+#define HM_ESTIMATOR_MAX_TRACKING_S 20.0
+#define HM_ESTIMATOR_MAX_RMS_WINDOW_M 1000.0
+
 typedef struct {
   double sample_rate_hz;          /* nominal acceleration sample rate, 100..5000 */
   double band_low_hz, band_high_hz; /* hunting band, 0 < low < high < 0.45 sample rate */

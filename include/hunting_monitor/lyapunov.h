@@ -23,6 +23,9 @@ typedef enum {
   HM_LYAP_DOPRI = 1     /* Dormand-Prince 5(4) on the variational system */
 } hm_lyap_method;
 
+/* Most midpoint steps or renormalisation intervals one call may take (about 10 minutes of work). */
+#define HM_LYAP_MAX_STEPS 1e9
+
 typedef struct {
   hm_lyap_method method;
   double step_s;            /* midpoint: fixed step [s] (> 0); the renormalisation interval is rounded to it */

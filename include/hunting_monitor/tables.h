@@ -36,6 +36,9 @@ extern "C" {
 
 typedef struct hm_table_s *hm_table;
 
+/* Largest speed a table may hold or be built for [km/h]: a parser bound, far above any rail vehicle. */
+#define HM_TABLE_MAX_SPEED_KMH 3000.0
+
 typedef struct {
   double conicity_min, conicity_max;  /* lambda(0) range */
   size_t n_conicity;                  /* grid points, >= 2 */
@@ -82,6 +85,12 @@ hm_status hm_table_lookup(const hm_table t, double conicity, double speed_kmh, h
 
 /* The stiffnesses [MN/m] of the vehicle the table was made for (a user checks them against its vehicle). */
 void hm_table_vehicle(const hm_table t, double *kx_mn_m, double *ky_mn_m);
+
+/* Whether the table was made for this vehicle: the stiffnesses agree to 1e-6 relative and every conicity's
+ * Hopf speed agrees with the vehicle's closed-form critical speed (linear.h) within tol_kmh. HM_EDOMAIN with
+ * the reason in why otherwise (a table of another vehicle, or a corrupt one, must not be used). */
+#define HM_TABLE_CHECK_TOL_KMH 0.01 /* tables are written with 10 significant digits: 1e-7 km/h of rounding */
+hm_status hm_table_check_vehicle(const hm_table t, const hm_vehicle *veh, double tol_kmh, char *why, size_t why_len);
 
 /* Number of conicities and the range, for reporting. */
 size_t hm_table_size(const hm_table t, double *conicity_min, double *conicity_max);

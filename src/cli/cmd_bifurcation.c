@@ -306,7 +306,10 @@ int cmd_cycles(const cli_args *a) {
       write_branch_csv(f, &fam, hm_param_name(p));
     else
       write_family_json(f, &hopf, &fam, cli_has(a, "refine") ? &fine : NULL, p);
-    if (path) fclose(f);
+    if (path && fclose(f) != 0) {
+      perror(path);
+      rc = 1;
+    }
   }
   free(fam.points);
   free(fine.points);

@@ -87,6 +87,12 @@ static hm_table load_or_build_table(const cli_args *a, const hm_vehicle *veh) {
       fprintf(stderr, "hunting: %s: %s\n", path, err);
       return NULL;
     }
+    /* a table of another vehicle (or an altered one) gives wrong margins: refuse it */
+    if (hm_table_check_vehicle(t, veh, HM_TABLE_CHECK_TOL_KMH, err, sizeof err) != HM_OK) {
+      fprintf(stderr, "hunting estimate: %s: not for this vehicle: %s\n", path, err);
+      hm_table_destroy(t);
+      return NULL;
+    }
     return t;
   }
   fprintf(stderr, "hunting estimate: no --table: computing boundary tables (conicity 0.05-0.40)...\n");
@@ -108,7 +114,12 @@ static int load_settings(const cli_args *a, const double *acc, size_t n_acc, con
   hm_alarm_config_default(ac);
   hm_conicity_eval(&veh->conicity, 0.0, &ac->conicity_fallback, NULL);
   const double rate = inferred_rate(acc, n_acc);
-  if (rate >= 100.0 && rate <= 5000.0) ec->sample_rate_hz = rate;
+  if (!(rate >= 100.0 && rate <= 5000.0)) { /* the filters cannot be designed for it: say so, do not guess */
+    fprintf(stderr, "hunting estimate: the acceleration data's sample rate is %.4g Hz; 100..5000 Hz is supported\n",
+            rate);
+    return 1;
+  }
+  ec->sample_rate_hz = rate;
   const char *path = cli_value(a, "monitor");
   char err[256] = "";
   if (path && hm_config_load_monitor(path, ec, ac, err, sizeof err) != HM_OK) {
@@ -138,6 +149,17 @@ int cmd_estimate(const cli_args *a) {
   int rc = 0;
   if (strcmp(h_acc[0], "t_s") != 0 || strcmp(h_acc[1], "accel_mps2") != 0) {
     fprintf(stderr, "hunting estimate: %s: the header must be 't_s,accel_mps2'\n", accel_path);
+    rc = 1;
+  }
+  size_t n_finite = 0;
+  for (size_t i = 0; rc == 0 && i < n_acc; ++i) n_finite += isfinite(acc[2 * i]) != 0;
+  if (rc == 0 && n_finite < 2) {
+    fprintf(stderr, "hunting estimate: %s: %s\n", accel_path,
+            n_acc == 0 ? "no samples (only a header)" : "fewer than two samples with a finite time stamp");
+    rc = 1;
+  }
+  if (rc == 0 && cli_has(a, "v") && !(v_const > 0.0 && v_const <= 1000.0)) {
+    fprintf(stderr, "hunting estimate: --v must be in (0, 1000] km/h, got %g\n", v_const);
     rc = 1;
   }
   if (rc == 0 && speed_path) {

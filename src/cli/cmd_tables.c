@@ -43,8 +43,8 @@ int cmd_tables(const cli_args *a) {
   hm_table t = NULL;
   hm_status st = hm_table_build(&veh, &spec, &t);
   if (st == HM_EINVAL) {
-    fprintf(stderr, "hunting tables: need 0 < --conicity-min < --conicity-max, 0 < --v-min < --v-max, "
-                    "--amp-max > 0.001\n");
+    fprintf(stderr, "hunting tables: need 0 < --conicity-min < --conicity-max, 0 < --v-min < --v-max <= %g, "
+                    "0.001 < --amp-max <= 0.1\n", HM_TABLE_MAX_SPEED_KMH);
     return 1;
   }
   if (st != HM_OK) return cli_fail_status("boundary table", st);

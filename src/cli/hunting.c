@@ -1,4 +1,5 @@
 /* hunting: command-line front end of the hunting_monitor C core (argument parsing and output only). */
+#include <errno.h>
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -183,6 +184,10 @@ static int sim_observer(hm_dopri integ, double t_old, double t_new, const double
       return 1;
     }
     write_row(w, t, x);
+    if (ferror(w->out) || (w->accel_out && ferror(w->accel_out)) || (w->speed_out && ferror(w->speed_out))) {
+      w->error = HM_EIO; /* a full disk: stop integrating for nobody */
+      return 1;
+    }
     w->next_index++;
   }
   return 0;
@@ -204,10 +209,17 @@ static int open_outputs(const cli_args *a, FILE **out, FILE **acc, FILE **spd) {
   return 0;
 }
 
-static void close_outputs(FILE *out, FILE *acc, FILE *spd) {
-  if (out && out != stdout) fclose(out);
-  if (acc) fclose(acc);
-  if (spd) fclose(spd);
+/* Close the files; nonzero (with a message) if anything written to them was lost. */
+static int close_outputs(const cli_args *a, FILE *out, FILE *acc, FILE *spd) {
+  const char *names[3] = {"out", "accel-out", "speed-out"};
+  FILE *files[3] = {out != stdout ? out : NULL, acc, spd};
+  int rc = 0;
+  for (int k = 0; k < 3; ++k)
+    if (files[k] && (ferror(files[k]) | fclose(files[k])) != 0) {
+      fprintf(stderr, "hunting simulate: %s: write error\n", cli_value(a, names[k]));
+      rc = 1;
+    }
+  return rc;
 }
 
 static int cmd_simulate(const cli_args *a) {
@@ -221,9 +233,10 @@ static int cmd_simulate(const cli_args *a) {
     return 1;
   if (isnan(v_end)) v_end = v_kmh;
   if (!(t_end > 0.0) || !(dt_out > 0.0) || t_end / dt_out > 1e8 || !(rtol > 0.0) || !(atol >= 0.0) ||
-      !(v_end > 0.0) || !(scale >= 0.0) || !(noise >= 0.0) || seed < 0.0 || seed != floor(seed)) {
+      !(v_end > 0.0) || !(scale >= 0.0) || !(noise >= 0.0) || !(seed >= 0.0 && seed <= 9007199254740992.0) ||
+      seed != floor(seed)) {
     fprintf(stderr, "hunting simulate: need --t > 0, --dt-out > 0 (at most 1e8 rows), --rtol > 0, --atol >= 0, "
-                    "--v-end > 0, --irregularity >= 0, --accel-noise >= 0 and a whole --seed >= 0\n");
+                    "--v-end > 0, --irregularity >= 0, --accel-noise >= 0 and a whole --seed in 0..2^53\n");
     return 1;
   }
   if (cli_has(a, "linear")) {
@@ -238,7 +251,7 @@ static int cmd_simulate(const cli_args *a) {
   if (st != HM_OK) return fail_status("model", st);
   FILE *out = NULL, *acc = NULL, *spd = NULL;
   if (open_outputs(a, &out, &acc, &spd)) {
-    close_outputs(out, acc, spd);
+    close_outputs(a, out, acc, spd);
     return 1;
   }
   fprintf(out, "t_s,y_m,dy_mps,psi_rad,dpsi_radps,accel_lat_mps2\n");
@@ -248,15 +261,15 @@ static int cmd_simulate(const cli_args *a) {
   write_row(&w, 0.0, x);
   hm_dopri integ = hm_dopri_create(4);
   if (!integ) {
-    close_outputs(out, acc, spd);
+    close_outputs(a, out, acc, spd);
     return fail_status("integrator", HM_ENOMEM);
   }
   const hm_ode_system sys = {4, hm_excited_rhs, NULL, &em};
   const hm_dopri_options opt = {rtol, atol, 0.0, scale > 0.0 ? 2e-3 : 0.0, 0};
   st = hm_dopri_integrate(integ, &sys, &opt, 0.0, t_end, x, NULL, sim_observer, &w, NULL);
   hm_dopri_destroy(integ);
-  if (st == HM_OK) st = w.error;
-  close_outputs(out, acc, spd);
+  if (st == HM_OK || w.error == HM_EIO) st = w.error;
+  if (close_outputs(a, out, acc, spd) || st == HM_EIO) return 1;
   if (st != HM_OK) return fail_status("simulation (the trajectory diverged or the step size collapsed)", st);
   return 0;
 }
@@ -306,7 +319,8 @@ static int cmd_lyapunov(const cli_args *a) {
   double exps[4], x_end[4], re[4], im[4];
   st = hm_lyapunov_spectrum(&sys, 0.0, x, 4, &opt, exps, x_end);
   if (st == HM_EINVAL) {
-    fprintf(stderr, "hunting lyapunov: invalid options (need --t > 0, --transient >= 0, 0 < --h <= --renorm)\n");
+    fprintf(stderr, "hunting lyapunov: invalid options (need --t > 0, --transient >= 0, 0 < --h <= --renorm <= --t, "
+                    "and at most %.0e steps of --h over --transient + --t)\n", HM_LYAP_MAX_STEPS);
     return 1;
   }
   if (st != HM_OK) return fail_status("Lyapunov spectrum", st);
@@ -485,7 +499,13 @@ int main(int argc, char **argv) {
       cli_print_help(stdout, c->name, c->usage, c->summary, c->opts);
       return 0;
     }
-    return c->run(&args);
+    const int rc = c->run(&args);
+    /* output lost (a full disk, a closed pipe) is a failure, not a success with nothing written */
+    if (fflush(stdout) != 0 || ferror(stdout)) {
+      fprintf(stderr, "hunting %s: cannot write the output: %s\n", c->name, strerror(errno));
+      return 1;
+    }
+    return rc;
   }
   fprintf(stderr, "hunting: unknown command '%s'\n\n", argv[1]);
   print_main_help(stderr);

@@ -84,6 +84,33 @@ static hm_status node_number(parse_ctx *c, yaml_node_t *n, const char *path, dou
   return HM_OK;
 }
 
+/* A number given in 10^decades units (MN/m: decades 6) converted in its decimal text, so that the SI value is the
+ * correctly rounded one: 8.81 MN/m reads as exactly strtod("8.81e6"), not 8.81 * 1e6 (which differs in the last
+ * bit, and would break the writer's promise that parsing gives back the same doubles). */
+static hm_status node_number_scaled(parse_ctx *c, yaml_node_t *n, const char *path, int decades, double *out) {
+  if (decades == 0) return node_number(c, n, path, out);
+  if (n->type != YAML_SCALAR_NODE) return fail(c, n, HM_EPARSE, "%s: expected a number", path);
+  const char *s = scalar_text(n);
+  char text[96], *end = NULL;
+  const char *e = strpbrk(s, "eE");
+  long exponent = 0;
+  if (e) {
+    errno = 0;
+    exponent = strtol(e + 1, &end, 10);
+    if (end == e + 1 || *end || errno == ERANGE || labs(exponent) > 10000)
+      return fail(c, n, HM_EPARSE, "%s: expected a finite number, got '%s'", path, s);
+  }
+  const int mant_len = e ? (int)(e - s) : (int)strlen(s);
+  if (mant_len <= 0 || mant_len > 64) return fail(c, n, HM_EPARSE, "%s: expected a finite number, got '%s'", path, s);
+  snprintf(text, sizeof text, "%.*se%ld", mant_len, s, exponent + decades);
+  errno = 0;
+  const double v = strtod(text, &end);
+  if (end == text || *end != '\0' || errno == ERANGE || !isfinite(v))
+    return fail(c, n, HM_EPARSE, "%s: expected a finite number, got '%s'", path, s);
+  *out = v;
+  return HM_OK;
+}
+
 static hm_status get_number(parse_ctx *c, yaml_node_t *map, const char *section, const char *key, double *out) {
   char path[96];
   snprintf(path, sizeof path, "%s.%s", section, key);
@@ -94,7 +121,7 @@ static hm_status get_number(parse_ctx *c, yaml_node_t *map, const char *section,
 
 typedef struct {
   const char *key;
-  double scale; /* config unit to SI */
+  int decades; /* config unit = 10^decades SI units */
   size_t offset;
 } number_field;
 
@@ -103,22 +130,25 @@ static hm_status parse_vehicle_section(parse_ctx *c, yaml_node_t *sec, hm_vehicl
                                         "spring_half_distance_m", "rolling_radius_m", "creep_long_n",
                                         "creep_lat_n", "spring_ratio", "kx_mn_m", "ky_mn_m", NULL};
   static const number_field fields[] = {
-      {"mass_kg", 1.0, offsetof(hm_vehicle, mass_kg)},
-      {"yaw_inertia_kg_m2", 1.0, offsetof(hm_vehicle, yaw_inertia_kg_m2)},
-      {"contact_half_distance_m", 1.0, offsetof(hm_vehicle, contact_half_distance_m)},
-      {"spring_half_distance_m", 1.0, offsetof(hm_vehicle, spring_half_distance_m)},
-      {"rolling_radius_m", 1.0, offsetof(hm_vehicle, rolling_radius_m)},
-      {"creep_long_n", 1.0, offsetof(hm_vehicle, creep_long_n)},
-      {"creep_lat_n", 1.0, offsetof(hm_vehicle, creep_lat_n)},
-      {"spring_ratio", 1.0, offsetof(hm_vehicle, spring_ratio)},
-      {"kx_mn_m", 1e6, offsetof(hm_vehicle, stiffness_long_n_m)},
-      {"ky_mn_m", 1e6, offsetof(hm_vehicle, stiffness_lat_n_m)},
+      {"mass_kg", 0, offsetof(hm_vehicle, mass_kg)},
+      {"yaw_inertia_kg_m2", 0, offsetof(hm_vehicle, yaw_inertia_kg_m2)},
+      {"contact_half_distance_m", 0, offsetof(hm_vehicle, contact_half_distance_m)},
+      {"spring_half_distance_m", 0, offsetof(hm_vehicle, spring_half_distance_m)},
+      {"rolling_radius_m", 0, offsetof(hm_vehicle, rolling_radius_m)},
+      {"creep_long_n", 0, offsetof(hm_vehicle, creep_long_n)},
+      {"creep_lat_n", 0, offsetof(hm_vehicle, creep_lat_n)},
+      {"spring_ratio", 0, offsetof(hm_vehicle, spring_ratio)},
+      {"kx_mn_m", 6, offsetof(hm_vehicle, stiffness_long_n_m)},
+      {"ky_mn_m", 6, offsetof(hm_vehicle, stiffness_lat_n_m)},
   };
   hm_status st = check_keys(c, sec, "vehicle", allowed);
   for (size_t i = 0; st == HM_OK && i < sizeof fields / sizeof fields[0]; ++i) {
     double v;
-    st = get_number(c, sec, "vehicle", fields[i].key, &v);
-    if (st == HM_OK) *(double *)((char *)veh + fields[i].offset) = v * fields[i].scale;
+    char path[96];
+    snprintf(path, sizeof path, "vehicle.%s", fields[i].key);
+    yaml_node_t *n = map_get(c, sec, fields[i].key);
+    st = n ? node_number_scaled(c, n, path, fields[i].decades, &v) : fail(c, sec, HM_EPARSE, "%s: missing key", path);
+    if (st == HM_OK) *(double *)((char *)veh + fields[i].offset) = v;
   }
   if (st != HM_OK) return st;
   yaml_node_t *n = map_get(c, sec, "name");
@@ -379,6 +409,22 @@ hm_status hm_config_load_monitor(const char *path, hm_estimator_config *est, hm_
 /* ---- writing ---- */
 
 
+/* The shortest decimal text of x / 10^decades that parses back (node_number_scaled) to exactly x. */
+static void scaled_text(double x, int decades, char *out, size_t len) {
+  char buf[40];
+  for (int prec = 0; prec <= 17; ++prec) {
+    snprintf(buf, sizeof buf, "%.*e", prec, x);
+    if (strtod(buf, NULL) == x) break;
+  }
+  char *e = strchr(buf, 'e');
+  const int exponent = (int)strtol(e + 1, NULL, 10) - decades;
+  *e = '\0';
+  if (exponent == 0)
+    snprintf(out, len, "%s", buf);
+  else
+    snprintf(out, len, "%se%d", buf, exponent);
+}
+
 hm_status hm_config_format_vehicle(const hm_vehicle *veh, const char *name, const char *comment, char *buf,
                                    size_t len, size_t *needed) {
   if (!veh || !needed || (len && !buf)) return HM_EINVAL;
@@ -404,8 +450,11 @@ hm_status hm_config_format_vehicle(const hm_vehicle *veh, const char *name, cons
   hm_text_sink_printf(&s, "  creep_long_n: %.17g\n", veh->creep_long_n);
   hm_text_sink_printf(&s, "  creep_lat_n: %.17g\n", veh->creep_lat_n);
   hm_text_sink_printf(&s, "  spring_ratio: %.17g\n", veh->spring_ratio);
-  hm_text_sink_printf(&s, "  kx_mn_m: %.17g\n", veh->stiffness_long_n_m * 1e-6);
-  hm_text_sink_printf(&s, "  ky_mn_m: %.17g\n", veh->stiffness_lat_n_m * 1e-6);
+  char kx[64], ky[64];
+  scaled_text(veh->stiffness_long_n_m, 6, kx, sizeof kx);
+  scaled_text(veh->stiffness_lat_n_m, 6, ky, sizeof ky);
+  hm_text_sink_printf(&s, "  kx_mn_m: %s\n", kx);
+  hm_text_sink_printf(&s, "  ky_mn_m: %s\n", ky);
   hm_text_sink_printf(&s, "conicity:\n  constant: %.17g\n  gaussians:%s\n", veh->conicity.constant,
        veh->conicity.n_terms ? "" : " []");
   for (size_t i = 0; i < veh->conicity.n_terms; ++i)

@@ -153,6 +153,21 @@ hm_status hm_estimator_config_validate(const hm_estimator_config *c, char *why, 
   if (!(c->conicity_max > c->conicity_min) || !isfinite(c->conicity_max))
     return bad(why, len, "conicity_max", "must be finite and above conicity_min", c->conicity_max);
   if (c->max_gap_s < 2.0 / fs) return bad(why, len, "max_gap_s", "must be at least two sample periods", c->max_gap_s);
+  /* upper bounds: the buffers are sized from these (estimator.h states the memory they bound) */
+  const struct {
+    const char *name;
+    double v, max;
+  } bounded[] = {{"tracking_time_s", c->tracking_time_s, HM_ESTIMATOR_MAX_TRACKING_S},
+                 {"rms_window_m", c->rms_window_m, HM_ESTIMATOR_MAX_RMS_WINDOW_M},
+                 {"conicity_time_s", c->conicity_time_s, 3600.0},
+                 {"max_gap_s", c->max_gap_s, 10.0},
+                 {"accel_timeout_s", c->accel_timeout_s, 60.0},
+                 {"speed_timeout_s", c->speed_timeout_s, 60.0}};
+  for (size_t i = 0; i < sizeof bounded / sizeof bounded[0]; ++i)
+    if (bounded[i].v > bounded[i].max) {
+      if (why && len) snprintf(why, len, "%s: must be at most %g (got %g)", bounded[i].name, bounded[i].max, bounded[i].v);
+      return HM_EDOMAIN;
+    }
   return HM_OK;
 }
 

@@ -106,10 +106,14 @@ static hm_status reorthonormalise(lyap_work *w, double *sums) {
 static int options_valid(const hm_lyap_options *o) {
   const int common = o->renorm_interval_s > 0.0 && isfinite(o->renorm_interval_s) && o->transient_s >= 0.0 &&
                      isfinite(o->transient_s) && o->duration_s > 0.0 && isfinite(o->duration_s);
-  if (!common) return 0;
+  /* bounded work: at most HM_LYAP_MAX_STEPS renormalisations or midpoint steps (a step of 1e-300 s is refused,
+   * not run for ever), and an interval no longer than the averaging time */
+  const double span = o->duration_s + o->transient_s;
+  if (!common || o->renorm_interval_s > o->duration_s || span / o->renorm_interval_s > HM_LYAP_MAX_STEPS) return 0;
   if (o->method == HM_LYAP_DOPRI) return o->rtol > 0.0 && o->atol >= 0.0;
   if (o->method == HM_LYAP_MIDPOINT)
-    return o->step_s > 0.0 && o->step_s <= o->renorm_interval_s && o->newton_tol > 0.0 && o->newton_max_iter > 0;
+    return o->step_s > 0.0 && o->step_s <= o->renorm_interval_s && span / o->step_s <= HM_LYAP_MAX_STEPS &&
+           o->newton_tol > 0.0 && o->newton_max_iter > 0;
   return 0;
 }
 

@@ -10,6 +10,7 @@
 
 #include "hunting_monitor/cycles.h"
 #include "hunting_monitor/hopf.h"
+#include "hunting_monitor/linear.h"
 #include "textsink.h"
 
 typedef struct {
@@ -267,9 +268,35 @@ static void midpoint_errors(hm_table t, const tcurve *mid, double *e_hopf, doubl
 }
 
 static int spec_valid(const hm_table_spec *s) {
-  return s->n_conicity >= 2 && s->n_conicity <= 1000 && s->conicity_min > 0.0 &&
+  return s->n_conicity >= 2 && s->n_conicity <= 1000 && s->conicity_min > 0.0 && isfinite(s->conicity_max) &&
          s->conicity_max > s->conicity_min && s->speed_min_kmh > 0.0 && s->speed_max_kmh > s->speed_min_kmh &&
-         s->amp_max_m > 1e-3 && s->rtol > 0.0;
+         s->speed_max_kmh <= HM_TABLE_MAX_SPEED_KMH && s->amp_max_m > 1e-3 && s->amp_max_m <= 0.1 && s->rtol > 0.0 &&
+         s->rtol < 1e-3;
+}
+
+hm_status hm_table_check_vehicle(const hm_table t, const hm_vehicle *veh, double tol_kmh, char *why, size_t len) {
+  if (!t || !veh || !(tol_kmh > 0.0)) return HM_EINVAL;
+  hm_status st = hm_vehicle_validate(veh, why, len);
+  if (st != HM_OK) return st;
+  const double kx = veh->stiffness_long_n_m * 1e-6, ky = veh->stiffness_lat_n_m * 1e-6;
+  if (fabs(t->kx_mn_m - kx) > 1e-6 * kx || fabs(t->ky_mn_m - ky) > 1e-6 * ky) {
+    if (why && len)
+      snprintf(why, len, "table made for Kx %g, Ky %g MN/m, vehicle has Kx %g, Ky %g MN/m", t->kx_mn_m, t->ky_mn_m,
+               kx, ky);
+    return HM_EDOMAIN;
+  }
+  for (size_t i = 0; i < t->n; ++i) {
+    double v_mps;
+    const hm_status s = hm_linear_critical_speed(veh, t->curves[i].conicity, &v_mps);
+    const double v = s == HM_OK ? hm_kmh_from_mps(v_mps) : NAN;
+    if (!(fabs(v - t->curves[i].hopf_kmh) <= tol_kmh)) {
+      if (why && len)
+        snprintf(why, len, "table Hopf speed %g km/h at conicity %g does not match the vehicle's %g km/h",
+                 t->curves[i].hopf_kmh, t->curves[i].conicity, v);
+      return HM_EDOMAIN;
+    }
+  }
+  return HM_OK;
 }
 
 hm_status hm_table_build(const hm_vehicle *veh, const hm_table_spec *spec, hm_table *out) {
@@ -399,6 +426,11 @@ static hm_status parse_curve(reader *r, char *line, tcurve *c, double prev_conic
   hm_status st = keyed(r, line, keys, v, 5);
   if (st != HM_OK) return st;
   if (!(v[0] > prev_conicity)) return perr(r, "conicities must increase");
+  /* plausibility: a monitor must refuse a table it cannot trust rather than read OK out of it */
+  if (!(v[0] > 0.0)) return perr(r, "conicity must be > 0");
+  if (!(v[1] > 0.0 && v[1] <= HM_TABLE_MAX_SPEED_KMH)) return perr(r, "hopf_kmh must be in (0, %g]", HM_TABLE_MAX_SPEED_KMH);
+  if (!(v[3] > 0.0 && v[3] <= v[1] * (1.0 + 1e-9)))
+    return perr(r, "lowest_kmh must be > 0 and not above hopf_kmh (cycles exist from the Hopf speed on)");
   if (!(v[4] >= 1.0 && v[4] <= 1e6) || v[4] != floor(v[4])) return perr(r, "bad point count");
   c->conicity = v[0];
   c->hopf_kmh = v[1];
@@ -420,6 +452,9 @@ static hm_status parse_curve(reader *r, char *line, tcurve *c, double prev_conic
     if (end == buf || e2 == end || e3 == e2 || *e3 || !isfinite(vk) || !isfinite(amp) || amp < 0.0 ||
         (stab != 0 && stab != 1) || errno == ERANGE)
       return perr(r, "expected 'v_kmh amplitude_m stable(0|1)'");
+    if (!(vk >= c->lowest_kmh * (1.0 - 1e-6) && vk <= HM_TABLE_MAX_SPEED_KMH))
+      return perr(r, "cycle speed %g km/h below lowest_kmh or above %g", vk, HM_TABLE_MAX_SPEED_KMH);
+    if (!(amp <= 0.1)) return perr(r, "cycle amplitude %g m is not plausible (above 0.1 m)", amp);
     c->pts[k] = (tpoint){vk, amp, (int)stab};
   }
   return HM_OK;
@@ -439,7 +474,11 @@ hm_status hm_table_parse(const char *text, size_t len, hm_table *out, char *err,
   if (st != HM_OK) return st;
   if (!next_line(&r, line, sizeof line)) return perr(&r, "missing error line");
   if ((st = keyed(&r, line, k2, h2, 3)) != HM_OK) return st;
-  if (!(h1[3] > h1[2])) return perr(&r, "speed range is empty");
+  if (!(h1[0] > 0.0 && h1[1] > 0.0)) return perr(&r, "kx_mn_m and ky_mn_m must be > 0");
+  if (!(h1[2] > 0.0 && h1[3] > h1[2] && h1[3] <= HM_TABLE_MAX_SPEED_KMH))
+    return perr(&r, "speed range must be 0 < speed_min_kmh < speed_max_kmh <= %g", HM_TABLE_MAX_SPEED_KMH);
+  if (!(h1[4] > 0.0 && h1[4] <= 0.1)) return perr(&r, "amp_max_m must be in (0, 0.1]");
+  if (!(h2[0] >= 0.0 && h2[1] >= 0.0 && h2[2] >= 0.0)) return perr(&r, "stated errors must be >= 0");
   /* count the curves first: every line starting with "conicity" */
   size_t n = 0;
   for (const char *q = r.p; q && q < r.end;) {
@@ -462,6 +501,9 @@ hm_status hm_table_parse(const char *text, size_t len, hm_table *out, char *err,
     prev = t->curves[i].conicity;
   }
   if (st == HM_OK && next_line(&r, line, sizeof line)) st = perr(&r, "unexpected text after the last record");
+  for (size_t i = 1; st == HM_OK && i < n; ++i) /* 1/V_hopf^2 is affine and increasing in lambda (tables.h) */
+    if (!(t->curves[i].hopf_kmh < t->curves[i - 1].hopf_kmh))
+      st = perr(&r, "hopf_kmh must decrease as the conicity increases (conicity %g)", t->curves[i].conicity);
   if (st != HM_OK) {
     hm_table_destroy(t);
     return st;

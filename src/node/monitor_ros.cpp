@@ -118,13 +118,9 @@ bool MonitorRos::loadParameters() {
     ROS_FATAL("hunting_monitor: ~table_file: %s", err);
     return false;
   }
-  // a table made for another vehicle would give wrong margins: its stiffnesses must be this vehicle's
-  double kx, ky;
-  hm_table_vehicle(table_, &kx, &ky);
-  const double vkx = vehicle_.stiffness_long_n_m * 1e-6, vky = vehicle_.stiffness_lat_n_m * 1e-6;
-  if (std::fabs(kx - vkx) > 1e-9 * vkx || std::fabs(ky - vky) > 1e-9 * std::fmax(vky, 1e-9)) {
-    ROS_FATAL("hunting_monitor: ~table_file %s was made for Kx %g, Ky %g MN/m but the vehicle has Kx %g, Ky %g",
-              table_file_.c_str(), kx, ky, vkx, vky);
+  // a table made for another vehicle (or altered) would give wrong margins: the core checks it against the vehicle
+  if (hm_table_check_vehicle(table_, &vehicle_, HM_TABLE_CHECK_TOL_KMH, err, sizeof err) != HM_OK) {
+    ROS_FATAL("hunting_monitor: ~table_file %s is not for this vehicle: %s", table_file_.c_str(), err);
     return false;
   }
   return true;

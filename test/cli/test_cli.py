@@ -394,6 +394,64 @@ def test_estimate_bad_and_stale_input():
             f.write("estimator:\n  rms_limit: 3\n")
         p = run("estimate", "--accel", acc, "--v", "400", "--table", tbl, "--monitor", mon, ok=False)
         assert p.returncode != 0 and "estimator.rms_limit: unknown key" in p.stderr, p.stderr
+        # found by fuzzing: huge buffer-sizing settings aborted with "double free or corruption"
+        with open(mon, "w") as f:
+            f.write("estimator:\n  tracking_time_s: 57646075230342348\n")
+        p = run("estimate", "--accel", acc, "--v", "400", "--table", tbl, "--monitor", mon, ok=False)
+        assert p.returncode == 1 and "tracking_time_s: must be at most 20" in p.stderr, p.stderr
+        # inputs that used to run without a word
+        def write(name, text):
+            path = os.path.join(d, name)
+            with open(path, "w") as f:
+                f.write(text)
+            return path
+        slow = write("slow.csv", "t_s,accel_mps2\n" + "".join(f"{i / 50:.3f},0.1\n" for i in range(500)))
+        corrupt = write("corrupt.tbl", open(tbl).read().replace("hopf_kmh ", "hopf_kmh 0 x", 1)
+                        .replace(" x", " junk ", 1))
+        cases = [
+            (["--accel", write("h.csv", "t_s,accel_mps2\n"), "--v", "400"], "no samples (only a header)"),
+            (["--accel", write("n.csv", "t_s,accel_mps2\nnan,1\nnan,2\nnan,3\n"), "--v", "400"],
+             "fewer than two samples with a finite time stamp"),
+            (["--accel", slow, "--v", "400"], "sample rate is 50 Hz; 100..5000 Hz is supported"),
+            (["--accel", acc, "--v", "-1"], "--v must be in (0, 1000] km/h"),
+            (["--accel", acc, "--v", "400", "--kx", "9.7"], "not for this vehicle: table made for Kx 8.96"),
+            (["--accel", acc, "--v", "400", "--table", corrupt], "line 4:"),
+        ]
+        for args, message in cases:
+            if "--table" not in args:
+                args = args + ["--table", tbl]
+            p = run("estimate", *args, ok=False)
+            assert p.returncode == 1 and message in p.stderr and p.stdout == "", (args, p.stderr)
+        # a table whose boundaries are implausible is refused, not read as OK
+        with open(tbl) as f:
+            text = f.read()
+        head, _, rest = text.partition("conicity ")
+        record, _, points = rest.partition("\n")
+        words = record.split()
+        words[words.index("hopf_kmh") + 1] = "0"
+        words[words.index("lowest_kmh") + 1] = "-5"
+        p = run("estimate", "--accel", acc, "--v", "300", "--table",
+                write("zero.tbl", head + "conicity " + " ".join(words[0:]) + "\n" + points), ok=False)
+        assert p.returncode == 1 and "hopf_kmh must be in (0, 3000]" in p.stderr, p.stderr
+
+
+def test_write_errors_are_failures():
+    if not os.path.exists("/dev/full"):
+        return
+    for args in (["critical"], ["simulate", "--v", "300", "--t", "0.1", "--out", "/dev/full"],
+                 ["simulate", "--v", "300", "--t", "0.1", "--out", "/dev/null", "--accel-out", "/dev/full"]):
+        with open("/dev/full", "w") as full:
+            p = subprocess.run([HUNTING, *args], stdout=full, stderr=subprocess.PIPE, text=True, timeout=60)
+        assert p.returncode == 1 and "write" in p.stderr, (args, p.returncode, p.stderr)
+
+
+def test_unbounded_work_is_refused():
+    for args, message in [(["lyapunov", "--v", "300", "--h", "1e-300"], "at most 1e+09 steps"),
+                          (["lyapunov", "--v", "300", "--renorm", "1e308"], "--renorm <= --t"),
+                          (["tables", "--v-max", "1e308", "--out", "/dev/null"], "--v-max <= 3000"),
+                          (["simulate", "--v", "300", "--seed", "1e308"], "whole --seed in 0..2^53")]:
+        p = run(*args, ok=False)
+        assert p.returncode == 1 and message in p.stderr, (args, p.stderr)
 
 
 def main():

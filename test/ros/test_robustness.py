@@ -151,7 +151,7 @@ class Robustness(unittest.TestCase):
             ("bad_rate", [], ["_status_rate_hz:=-1"], "~status_rate_hz must be in (0, 1000]"),
             ("bad_mass", [("vehicle", "mass_kg", -1869)], [], "vehicle.mass_kg: must be > 0"),
             ("bad_type", [], ["_accel_type:=twist"], "~accel_type must be imu or float64"),
-            ("bad_table", [("vehicle", "kx_mn_m", 9.7)], [], "was made for Kx 8.96"),
+            ("bad_table", [("vehicle", "kx_mn_m", 9.7)], [], "table made for Kx 8.96"),
             ("bad_key", [("vehicle", "mas_kg", 1)], [], "vehicle.mas_kg: unknown key"),
         ]
         for name, changes, extra, message in cases:

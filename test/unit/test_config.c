@@ -152,12 +152,36 @@ static void format_round_trip(void) {
   char name[HM_VEHICLE_NAME_MAX], err[256] = "";
   HM_CHECK(hm_config_parse_vehicle(buf, need - 1, "rt", &back, name, err, sizeof err) == HM_OK, "parse: %s", err);
   HM_CHECK(strcmp(name, "round trip") == 0, "name '%s'", name);
-  HM_CHECK(back.stiffness_long_n_m == v.stiffness_long_n_m || fabs(back.stiffness_long_n_m / v.stiffness_long_n_m - 1) < 1e-15,
-           "Kx %.17g vs %.17g", back.stiffness_long_n_m, v.stiffness_long_n_m);
+  HM_CHECK(back.stiffness_long_n_m == v.stiffness_long_n_m, "Kx %.17g vs %.17g", back.stiffness_long_n_m,
+           v.stiffness_long_n_m);
   HM_CHECK(back.conicity.terms[1].width_m == v.conicity.terms[1].width_m && back.mass_kg == v.mass_kg &&
                back.flange_alpha2_n_m5 == v.flange_alpha2_n_m5 && back.conicity.n_terms == 2,
            "fields differ after the round trip");
   free(buf);
+  /* unit-converted fields give back the same doubles (8.81 MN/m once read back as 8809999.9999999981 N/m) */
+  int exact = 1;
+  for (int i = 0; i < 2000 && exact; ++i) {
+    hm_vehicle w;
+    hm_vehicle_default(&w);
+    w.stiffness_long_n_m = i == 0 ? 8810000.0 : hm_test_uniform(1e5, 5e7);
+    w.stiffness_lat_n_m = i == 0 ? 8809999.9999999981 : floor(hm_test_uniform(1e5, 5e7) / 1e4) * 1e4;
+    char text[4096];
+    hm_status st = hm_config_format_vehicle(&w, "", NULL, text, sizeof text, &need);
+    if (st == HM_OK) st = hm_config_parse_vehicle(text, need - 1, "rt", &back, name, err, sizeof err);
+    exact = st == HM_OK && back.stiffness_long_n_m == w.stiffness_long_n_m &&
+            back.stiffness_lat_n_m == w.stiffness_lat_n_m;
+    HM_CHECK(exact, "case %d: Kx %.17g -> %.17g, Ky %.17g -> %.17g (%s)", i, w.stiffness_long_n_m,
+             back.stiffness_long_n_m, w.stiffness_lat_n_m, back.stiffness_lat_n_m, err);
+  }
+  /* and a hand-written 8.81 reads as the double nearest to 8.81e6 */
+  const char *doc = "vehicle:\n  mass_kg: 1869\n  yaw_inertia_kg_m2: 910\n  contact_half_distance_m: 0.7465\n"
+                    "  spring_half_distance_m: 1\n  rolling_radius_m: 0.43\n  creep_long_n: 7.99e6\n"
+                    "  creep_lat_n: 7.99e6\n  spring_ratio: 1.351186\n  kx_mn_m: 8.81\n  ky_mn_m: 1.5e-1\n"
+                    "conicity:\n  constant: 0.1358\n  gaussians: []\n"
+                    "flange:\n  alpha1_n_m3: -1.6e11\n  alpha2_n_m5: 1.6e15\n";
+  HM_CHECK(hm_config_parse_vehicle(doc, strlen(doc), "doc", &back, name, err, sizeof err) == HM_OK, "%s", err);
+  HM_CHECK(back.stiffness_long_n_m == 8810000.0 && back.stiffness_lat_n_m == 150000.0, "Kx %.17g Ky %.17g",
+           back.stiffness_long_n_m, back.stiffness_lat_n_m);
 }
 
 static int same_alarm(const hm_alarm_config *x, const hm_alarm_config *y) { /* field by field: padding */
@@ -192,6 +216,9 @@ static void monitor_settings(void) {
       {"estimator:\n  peaks_count: 6.5\n", "estimator.peaks_count: expected a whole number", HM_EPARSE},
       {"estimator:\n  sample_rate_hz: 20\n", "estimator.sample_rate_hz: must be in 100..5000", HM_EDOMAIN},
       {"alarm:\n  min_hold_s: -1\n", "alarm.min_hold_s: out of range", HM_EDOMAIN},
+      /* found by fuzzing: huge values sized the buffers by an overflowing float-to-size_t conversion */
+      {"estimator:\n  tracking_time_s: 57646075230342348\n", "tracking_time_s: must be at most 20", HM_EDOMAIN},
+      {"estimator:\n  rms_window_m: 1e300\n", "rms_window_m: must be at most 1000", HM_EDOMAIN},
   };
   for (size_t i = 0; i < sizeof bad / sizeof bad[0]; ++i) {
     hm_estimator_config e2 = de;

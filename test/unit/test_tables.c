@@ -106,6 +106,28 @@ static void malformed_tables(void) {
       {"conicity 0.1 hopf_kmh 600 l1 1 lowest_kmh 250 n 1\n600 0 2\nconicity 0.2 hopf_kmh 500 l1 1 "
        "lowest_kmh 250 n 1\n500 0 1\n",
        "line 5: expected"},
+      /* implausible boundaries (found by fuzzing: read as OK "below the lowest speed with a cycle") */
+      {"conicity 0.1 hopf_kmh 0 l1 1 lowest_kmh -5 n 1\n600 0 1\nconicity 0.2 hopf_kmh 500 l1 1 "
+       "lowest_kmh 250 n 1\n500 0 1\n",
+       "line 4: hopf_kmh must be in (0, 3000]"},
+      {"conicity 0.1 hopf_kmh 600 l1 1 lowest_kmh -5 n 1\n600 0 1\nconicity 0.2 hopf_kmh 500 l1 1 "
+       "lowest_kmh 250 n 1\n500 0 1\n",
+       "line 4: lowest_kmh must be > 0 and not above hopf_kmh"},
+      {"conicity 0.1 hopf_kmh 600 l1 1 lowest_kmh 650 n 1\n600 0 1\nconicity 0.2 hopf_kmh 500 l1 1 "
+       "lowest_kmh 250 n 1\n500 0 1\n",
+       "line 4: lowest_kmh must be > 0 and not above hopf_kmh"},
+      {"conicity 0.1 hopf_kmh 600 l1 1 lowest_kmh 250 n 1\n100 0 1\nconicity 0.2 hopf_kmh 500 l1 1 "
+       "lowest_kmh 250 n 1\n500 0 1\n",
+       "line 5: cycle speed 100 km/h below lowest_kmh"},
+      {"conicity 0.1 hopf_kmh 600 l1 1 lowest_kmh 250 n 1\n600 5 1\nconicity 0.2 hopf_kmh 500 l1 1 "
+       "lowest_kmh 250 n 1\n500 0 1\n",
+       "line 5: cycle amplitude 5 m is not plausible"},
+      {"conicity 0.1 hopf_kmh 500 l1 1 lowest_kmh 250 n 1\n500 0 1\nconicity 0.2 hopf_kmh 600 l1 1 "
+       "lowest_kmh 250 n 1\n600 0 1\n",
+       "hopf_kmh must decrease as the conicity increases"},
+      {"conicity -0.1 hopf_kmh 600 l1 1 lowest_kmh 250 n 1\n600 0 1\nconicity 0.2 hopf_kmh 500 l1 1 "
+       "lowest_kmh 250 n 1\n500 0 1\n",
+       "line 4: conicity must be > 0"},
   };
   for (size_t i = 0; i < sizeof cases / sizeof cases[0]; ++i) {
     char text[1024], err[160] = "";
@@ -120,12 +142,61 @@ static void malformed_tables(void) {
   hm_table t = NULL;
   HM_CHECK(hm_table_parse("not a table\n", 12, &t, err, sizeof err) == HM_EPARSE && strstr(err, "line 1"), "%s", err);
   HM_CHECK(hm_table_load_file("/nonexistent.tbl", &t, err, sizeof err) == HM_EIO, "missing file");
+  /* header plausibility */
+  const char *bad_head = "hunting_monitor_boundary_table 1\n"
+                         "kx_mn_m -8.96 ky_mn_m 8.96 speed_min_kmh 150 speed_max_kmh 700 amp_max_m 0.016\n"
+                         "error_hopf_kmh 0 error_lowest_kmh 0.1 error_edge_amp_m 1e-4\n";
+  HM_CHECK(hm_table_parse(bad_head, strlen(bad_head), &t, err, sizeof err) == HM_EPARSE &&
+               strstr(err, "kx_mn_m and ky_mn_m must be > 0"),
+           "%s", err);
   hm_table_lookup_result r;
   memset(&r, 0x33, sizeof r);
   const hm_table_lookup_result before = r;
   HM_CHECK(hm_table_lookup(table, NAN, 300.0, &r) == HM_EDOMAIN, "NaN conicity");
   HM_CHECK(hm_table_lookup(table, 0.13, INFINITY, &r) == HM_EDOMAIN, "infinite speed");
   HM_CHECK(memcmp(&r, &before, sizeof r) == 0, "lookup output changed on failure");
+}
+
+/* A table is used only for the vehicle it was made for: the shipped table fits the default vehicle (its Hopf
+ * speeds within 1e-3 km/h of the closed form), and is refused for other stiffnesses, other creep coefficients (same
+ * Kx/Ky, different Hopf speeds) and when one record was altered. */
+static void table_checked_against_vehicle(void) {
+  hm_table shipped = NULL;
+  char err[256] = "";
+  HM_CHECK(hm_table_load_file(HM_SOURCE_DIR "/config/crh380_default.tbl", &shipped, err, sizeof err) == HM_OK, "%s", err);
+  if (!shipped) return;
+  HM_CHECK(hm_table_check_vehicle(shipped, &vehicle, 1e-3, err, sizeof err) == HM_OK, "shipped table: %s", err);
+  hm_vehicle other = vehicle;
+  other.stiffness_long_n_m = 9.7e6;
+  HM_CHECK(hm_table_check_vehicle(shipped, &other, 1e-3, err, sizeof err) == HM_EDOMAIN &&
+               strstr(err, "table made for Kx 8.96, Ky 8.96 MN/m, vehicle has Kx 9.7"),
+           "other Kx: %s", err);
+  other = vehicle;
+  other.creep_long_n *= 1.1;
+  HM_CHECK(hm_table_check_vehicle(shipped, &other, 1e-3, err, sizeof err) == HM_EDOMAIN &&
+               strstr(err, "does not match the vehicle's"),
+           "other creep: %s", err);
+  hm_table_destroy(shipped);
+  /* one Hopf speed altered by 2 km/h in the text */
+  size_t need = 0;
+  hm_table_format(table, NULL, 0, &need);
+  char *text = malloc(need);
+  HM_CHECK(text && hm_table_format(table, text, need, &need) == HM_OK, "format");
+  if (!text) return;
+  char *h = strstr(text, " hopf_kmh "); /* the first record's (not error_hopf_kmh) */
+  if (h) ++h;
+  hm_table altered = NULL;
+  if (h) {
+    const double v = strtod(h + 9, NULL);
+    char *rest = strstr(h, " l1 ");
+    char *copy = malloc(need + 64);
+    snprintf(copy, need + 64, "%.*shopf_kmh %.10g%s", (int)(h - text), text, v - 2.0, rest);
+    HM_CHECK(hm_table_parse(copy, strlen(copy), &altered, err, sizeof err) == HM_OK, "%s", err);
+    HM_CHECK(altered && hm_table_check_vehicle(altered, &vehicle, 1.0, err, sizeof err) == HM_EDOMAIN, "altered");
+    hm_table_destroy(altered);
+    free(copy);
+  }
+  free(text);
 }
 
 int main(void) {
@@ -138,6 +209,7 @@ int main(void) {
   HM_RUN(lookup_matches_direct_continuation);
   HM_RUN(round_trip);
   HM_RUN(malformed_tables);
+  HM_RUN(table_checked_against_vehicle);
   hm_table_destroy(table);
   HM_TEST_EXIT();
 }
