@@ -29,8 +29,7 @@
 
 #include <stddef.h>
 
-#include "hunting_monitor/alarm.h"
-#include "hunting_monitor/estimator.h"
+#include "hunting_monitor/monitor.h"
 #include "hunting_monitor/model.h"
 #include "hunting_monitor/status.h"
 
@@ -53,16 +52,17 @@ hm_status hm_config_parse_vehicle(const char *text, size_t len, const char *sour
 hm_status hm_config_load_vehicle(const char *path, hm_vehicle *veh, char *name, char *err, size_t err_len);
 
 /*
- * Monitor settings (config/monitor.yaml): optional sections `estimator:` and `alarm:` whose keys are the field
- * names of hm_estimator_config and hm_alarm_config (use_conicity_estimate: true/false). Fields not given keep
- * the values *est and *alarm hold on entry (pass the defaults); unknown keys and non-numbers are errors (HM_EPARSE),
- * then the whole configuration is validated (HM_EDOMAIN). Outputs untouched on failure. Other top-level sections
- * (vehicle, conicity, flange) are ignored, so one file may hold both.
+ * Monitor settings (config/monitor.yaml): optional sections `estimator:`, `modal:`, `margin:` and `alarm:` whose
+ * keys are the field names of hm_estimator_config, hm_modal_config, hm_margin_config and hm_alarm_config
+ * (use_conicity_estimate: true/false; measurement_point: wheelset/bogie_frame, which first sets the criteria's
+ * defaults for that point, hm_estimator_config_criteria, then the section's other keys apply). Fields not given keep
+ * the values *cfg holds on entry (pass the defaults); unknown keys and non-numbers are errors (HM_EPARSE), then the
+ * whole configuration is validated (HM_EDOMAIN). Output untouched on failure. Other top-level sections (vehicle,
+ * conicity, flange) are ignored, so one file may hold both.
  */
-hm_status hm_config_parse_monitor(const char *text, size_t len, const char *source, hm_estimator_config *est,
-                                  hm_alarm_config *alarm, char *err, size_t err_len);
-hm_status hm_config_load_monitor(const char *path, hm_estimator_config *est, hm_alarm_config *alarm, char *err,
-                                 size_t err_len);
+hm_status hm_config_parse_monitor(const char *text, size_t len, const char *source, hm_monitor_config *cfg, char *err,
+                                  size_t err_len);
+hm_status hm_config_load_monitor(const char *path, hm_monitor_config *cfg, char *err, size_t err_len);
 
 /*
  * Write veh as a complete vehicle config (the format above, values with 17 significant digits so that parsing

@@ -5,9 +5,8 @@
 #include <string.h>
 
 #include "cli.h"
-#include "hunting_monitor/alarm.h"
 #include "hunting_monitor/config.h"
-#include "hunting_monitor/estimator.h"
+#include "hunting_monitor/monitor.h"
 #include "hunting_monitor/tables.h"
 
 const cli_option estimate_opts[] = {
@@ -39,7 +38,11 @@ static double inferred_rate(const double *d, size_t n) {
   return 1.0 / dt[m / 2];
 }
 
-static void write_line(const hm_estimate *e, const hm_assessment *s, double t) {
+static void write_line(const hm_monitor_status *st, double t) {
+  const hm_estimate *e = &st->estimate;
+  const hm_assessment *s = &st->assessment;
+  const hm_margin_estimate *g = &st->margin;
+  const hm_mode_estimate *md = &st->mode;
   json_writer w;
   jw_init(&w, stdout);
   jw_object(&w, NULL);
@@ -51,20 +54,46 @@ static void write_line(const hm_estimate *e, const hm_assessment *s, double t) {
   jw_bool(&w, "speed_valid", e->speed_valid);
   jw_number(&w, "speed_kmh", e->speed_kmh);
   jw_bool(&w, "accel_valid", e->accel_valid);
+  jw_number(&w, "sample_rate_hz", e->sample_rate_measured_hz);
+  jw_bool(&w, "sample_rate_mismatch", e->sample_rate_mismatch);
   jw_bool(&w, "oscillation_valid", e->oscillation_valid);
   jw_number(&w, "amplitude_accel_mps2", e->amplitude_accel_mps2);
   jw_number(&w, "frequency_hz", e->frequency_hz);
   jw_number(&w, "amplitude_m", e->amplitude_displacement_m);
-  jw_bool(&w, "conicity_valid", e->conicity_valid);
-  jw_number(&w, "conicity_estimate", e->conicity);
-  jw_number(&w, "conicity_confidence", e->conicity_confidence);
+  /* the identified hunting mode (the latest window) */
+  jw_bool(&w, "mode_valid", md->valid);
+  jw_number(&w, "mode_frequency_hz", md->valid ? md->frequency_hz : NAN);
+  jw_number(&w, "mode_frequency_se_hz", md->valid ? md->frequency_se_hz : NAN);
+  jw_number(&w, "decay_rate_1_s", md->valid ? md->decay_rate_1_s : NAN);
+  jw_number(&w, "decay_rate_se_1_s", md->valid ? md->decay_rate_se_1_s : NAN);
+  jw_number(&w, "damping_ratio", md->valid ? md->damping_ratio : NAN);
+  jw_number(&w, "damping_ratio_se", md->valid ? md->damping_ratio_se : NAN);
+  jw_number(&w, "mode_speed_kmh", md->valid ? st->mode_speed_kmh : NAN);
+  jw_number(&w, "mode_speed_spread_kmh", md->valid && st->mode_speed_spread_kmh >= 0.0 ? st->mode_speed_spread_kmh : NAN);
+  jw_int(&w, "mode_window_verdict", (long)st->mode_verdict);
+  jw_int(&w, "windows_used", (long)g->n_windows);
+  /* the margin: model-based and model-free Hopf speeds */
+  jw_bool(&w, "conicity_valid", g->conicity_valid);
+  jw_number(&w, "conicity_estimate", g->conicity_valid ? g->conicity : NAN);
+  jw_number(&w, "conicity_se", g->conicity_valid ? g->conicity_se : NAN);
+  jw_number(&w, "hopf_model_kmh", g->hopf_model_valid ? g->hopf_model_kmh : NAN);
+  jw_number(&w, "hopf_model_kmh_low", g->hopf_model_valid ? g->hopf_model_low_kmh : NAN);
+  jw_number(&w, "hopf_model_kmh_high", g->hopf_model_valid ? g->hopf_model_high_kmh : NAN);
+  jw_bool(&w, "hopf_free_valid", g->hopf_free_valid);
+  jw_number(&w, "hopf_free_kmh", g->hopf_free_valid ? g->hopf_free_kmh : NAN);
+  jw_number(&w, "hopf_free_kmh_low", g->hopf_free_valid ? g->hopf_free_low_kmh : NAN);
+  jw_number(&w, "hopf_free_kmh_high", g->hopf_free_valid ? g->hopf_free_high_kmh : NAN);
+  jw_bool(&w, "model_mismatch", g->model_mismatch);
   const int b = s->boundaries_valid; /* no margins are shown as current without data */
   jw_number(&w, "conicity_used", b ? s->conicity : NAN);
+  jw_bool(&w, "conicity_from_estimate", b && s->conicity_from_estimate);
   jw_number(&w, "hopf_kmh", b ? s->boundaries.hopf_speed_kmh : NAN);
+  jw_number(&w, "hopf_kmh_low", b ? s->hopf_low_kmh : NAN);
+  jw_number(&w, "hopf_kmh_high", b ? s->hopf_high_kmh : NAN);
   jw_number(&w, "lowest_cycle_kmh", b ? s->boundaries.lowest_cycle_speed_kmh : NAN);
   jw_number(&w, "margin_hopf_kmh", b ? s->margin_hopf_kmh : NAN);
   jw_number(&w, "margin_lowest_cycle_kmh", b ? s->margin_lowest_cycle_kmh : NAN);
-  jw_number(&w, "unstable_cycle_amplitude_m", b && s->boundaries.has_edge ? s->boundaries.edge_amp_m : NAN);
+  jw_number(&w, "unstable_cycle_amplitude_m", b && s->edge_used_m > 0.0 ? s->edge_used_m : NAN);
   jw_number(&w, "stable_cycle_amplitude_m",
             b && s->boundaries.has_stable_outer ? s->boundaries.stable_outer_amp_m : NAN);
   jw_number(&w, "rms_mps2", e->rms_mps2);
@@ -78,56 +107,36 @@ static void write_line(const hm_estimate *e, const hm_assessment *s, double t) {
   jw_finish(&w);
 }
 
-static hm_table load_or_build_table(const cli_args *a, const hm_vehicle *veh) {
-  hm_table t = NULL;
+/* A table from --table, or NULL: the monitor then computes one for the vehicle. */
+static int load_table(const cli_args *a, hm_table *t) {
+  *t = NULL;
   const char *path = cli_value(a, "table");
-  if (path) {
-    char err[256] = "";
-    if (hm_table_load_file(path, &t, err, sizeof err) != HM_OK) {
-      fprintf(stderr, "hunting: %s: %s\n", path, err);
-      return NULL;
-    }
-    /* a table of another vehicle (or an altered one) gives wrong margins: refuse it */
-    if (hm_table_check_vehicle(t, veh, HM_TABLE_CHECK_TOL_KMH, err, sizeof err) != HM_OK) {
-      fprintf(stderr, "hunting estimate: %s: not for this vehicle: %s\n", path, err);
-      hm_table_destroy(t);
-      return NULL;
-    }
-    return t;
+  if (!path) {
+    fprintf(stderr, "hunting estimate: no --table: computing boundary tables (conicity 0.05-0.40)...\n");
+    return 0;
   }
-  fprintf(stderr, "hunting estimate: no --table: computing boundary tables (conicity 0.05-0.40)...\n");
-  hm_table_spec spec;
-  hm_table_spec_default(&spec);
-  spec.n_conicity = 8;
-  hm_status st = hm_table_build(veh, &spec, &t);
-  if (st != HM_OK) {
-    cli_fail_status("boundary tables", st);
-    return NULL;
+  char err[256] = "";
+  if (hm_table_load_file(path, t, err, sizeof err) != HM_OK) {
+    fprintf(stderr, "hunting: %s: %s\n", path, err);
+    return 1;
   }
-  return t;
+  return 0;
 }
 
 /* Settings: the built-in defaults, the data's rate, then the settings file if given. */
-static int load_settings(const cli_args *a, const double *acc, size_t n_acc, const hm_vehicle *veh,
-                         hm_estimator_config *ec, hm_alarm_config *ac) {
-  hm_estimator_config_default(ec);
-  hm_alarm_config_default(ac);
-  hm_conicity_eval(&veh->conicity, 0.0, &ac->conicity_fallback, NULL);
+static int load_settings(const cli_args *a, const double *acc, size_t n_acc, hm_monitor_config *cfg) {
+  hm_monitor_config_default(cfg);
   const double rate = inferred_rate(acc, n_acc);
   if (!(rate >= 100.0 && rate <= 5000.0)) { /* the filters cannot be designed for it: say so, do not guess */
     fprintf(stderr, "hunting estimate: the acceleration data's sample rate is %.4g Hz; 100..5000 Hz is supported\n",
             rate);
     return 1;
   }
-  ec->sample_rate_hz = rate;
+  cfg->estimator.sample_rate_hz = rate;
   const char *path = cli_value(a, "monitor");
   char err[256] = "";
-  if (path && hm_config_load_monitor(path, ec, ac, err, sizeof err) != HM_OK) {
+  if (path && hm_config_load_monitor(path, cfg, err, sizeof err) != HM_OK) {
     fprintf(stderr, "hunting: monitor settings: %s\n", err);
-    return 1;
-  }
-  if (hm_estimator_config_validate(ec, err, sizeof err) != HM_OK) {
-    fprintf(stderr, "hunting estimate: estimator settings: %s (the data's sample rate is %.1f Hz)\n", err, rate);
     return 1;
   }
   return 0;
@@ -169,48 +178,41 @@ int cmd_estimate(const cli_args *a) {
       rc = 1;
     }
   }
-  hm_estimator_config ec;
-  hm_alarm_config ac;
+  hm_monitor_config cfg;
+  hm_monitor mon = NULL;
   hm_table table = NULL;
-  hm_estimator est = NULL;
-  hm_alarm alarm = NULL;
-  if (rc == 0) rc = load_settings(a, acc, n_acc, &veh, &ec, &ac);
-  if (rc == 0 && !(table = load_or_build_table(a, &veh))) rc = 1;
-  if (rc == 0 && (!(est = hm_estimator_create(&ec, &veh)) || !(alarm = hm_alarm_create(&ac, table)))) {
-    cli_fail_status("estimator", HM_ENOMEM);
-    rc = 1;
+  if (rc == 0) rc = load_settings(a, acc, n_acc, &cfg);
+  if (rc == 0) rc = load_table(a, &table);
+  if (rc == 0) {
+    char why[256] = "";
+    const hm_status st = hm_monitor_create(&cfg, &veh, table, &mon, why, sizeof why);
+    if (st != HM_OK) {
+      fprintf(stderr, "hunting estimate: %s%s%s\n", cli_value(a, "table") && strstr(why, "table") ? cli_value(a, "table") : "",
+              cli_value(a, "table") && strstr(why, "table") ? ": not for this vehicle: " : "", *why ? why : hm_status_str(st));
+      rc = 1;
+    }
   }
   size_t k = 0;
   double next_out = n_acc ? acc[0] + every : 0.0, t_written = -INFINITY, t_last = -INFINITY;
+  hm_monitor_status st;
   for (size_t i = 0; rc == 0 && i < n_acc; ++i) {
     const double t = acc[2 * i];
     if (spd)
-      for (; k < n_spd && spd[2 * k] <= t; ++k) hm_estimator_push_speed(est, spd[2 * k], spd[2 * k + 1]);
+      for (; k < n_spd && spd[2 * k] <= t; ++k) hm_monitor_push_speed(mon, spd[2 * k], spd[2 * k + 1]);
     else if (i % 10 == 0)
-      hm_estimator_push_speed(est, t, v_const);
-    hm_estimator_push_accel(est, t, acc[2 * i + 1]);
+      hm_monitor_push_speed(mon, t, v_const);
+    hm_monitor_push_accel(mon, t, acc[2 * i + 1]);
     if (isfinite(t)) t_last = fmax(t_last, t);
     /* one line per interval of data time, and one at the end of the data */
-    if (isfinite(t) && (t >= next_out || i + 1 == n_acc)) {
-      hm_estimate e;
-      hm_assessment s;
-      hm_estimator_read(est, t, &e);
-      hm_alarm_update(alarm, &e, t, &s);
-      write_line(&e, &s, t);
+    if (isfinite(t) && (t >= next_out || i + 1 == n_acc) && hm_monitor_update(mon, t, &st) == HM_OK) {
+      write_line(&st, t);
       t_written = t;
       if (t >= next_out) next_out = t + every - fmod(t - next_out, every);
     }
   }
-  if (rc == 0 && isfinite(t_last) && t_written < t_last) { /* the last rows were not finite times */
-    hm_estimate e;
-    hm_assessment s;
-    hm_estimator_read(est, t_last, &e);
-    hm_alarm_update(alarm, &e, t_last, &s);
-    write_line(&e, &s, t_last);
-  }
-  hm_alarm_destroy(alarm);
-  hm_estimator_destroy(est);
-  hm_table_destroy(table);
+  if (rc == 0 && isfinite(t_last) && t_written < t_last && hm_monitor_update(mon, t_last, &st) == HM_OK)
+    write_line(&st, t_last); /* the last rows were not finite times */
+  hm_monitor_destroy(mon);
   free(acc);
   free(spd);
   return rc;

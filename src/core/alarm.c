@@ -14,10 +14,9 @@ struct hm_alarm_s {
   double since;
   int lower_pending;      /* the conditions for a lower level hold since lower_since */
   double lower_since;
-  int using_estimate;     /* the conicity estimate is in use (entered at the confidence threshold, left below half) */
-  int have_lookup;        /* the last table lookup, reused while conicity and speed are unchanged */
-  double lookup_conicity, lookup_speed;
-  hm_table_lookup_result lookup;
+  int have_lookup;        /* the last table lookups, reused while conicities and speed are unchanged */
+  double lookup_conicity, lookup_opt_conicity, lookup_speed;
+  hm_table_lookup_result lookup, lookup_opt;
 };
 
 const char *hm_level_name(hm_level l) {
@@ -31,13 +30,17 @@ const char *hm_reason_text(hm_reason r) {
     case HM_REASON_NO_ACCEL: return "no current lateral acceleration";
     case HM_REASON_NO_SPEED: return "no current speed";
     case HM_REASON_BELOW_LOWEST_CYCLE: return "below the lowest speed with a limit cycle";
-    case HM_REASON_BISTABLE_BAND: return "in the bistable band: a large disturbance can start hunting";
+    case HM_REASON_NORMAL: return "normal running";
     case HM_REASON_NEAR_HOPF: return "near the linear critical (Hopf) speed";
     case HM_REASON_AMPLITUDE_NEAR_EDGE: return "oscillation approaching the unstable cycle";
-    case HM_REASON_ABOVE_HOPF: return "at or above the linear critical (Hopf) speed";
+    case HM_REASON_ABOVE_HOPF: return "above the linear critical (Hopf) speed";
     case HM_REASON_AMPLITUDE_BEYOND_EDGE: return "oscillation at or beyond the unstable cycle";
     case HM_REASON_RMS_CRITERION: return "sliding r.m.s. criterion exceeded";
     case HM_REASON_PEAKS_CRITERION: return "consecutive peaks criterion exceeded";
+    case HM_REASON_APPROACHING_HOPF: return "approaching the linear critical (Hopf) speed";
+    case HM_REASON_MODEL_MISMATCH: return "the vehicle does not behave like its model";
+    case HM_REASON_RATE_MISMATCH: return "the sensor delivers another sample rate than configured";
+    case HM_REASON_BAD_SAMPLE_RATE: return "acceleration at a sample rate the filters cannot use";
   }
   return "?";
 }
@@ -45,12 +48,13 @@ const char *hm_reason_text(hm_reason r) {
 void hm_alarm_config_default(hm_alarm_config *c) {
   c->warn_amplitude_fraction = 0.5;
   c->warn_speed_margin_kmh = 10.0;
+  c->watch_speed_margin_kmh = 30.0;
   c->hysteresis_kmh = 3.0;
   c->hysteresis_amplitude_fraction = 0.1;
   c->min_hold_s = 3.0;
   c->use_conicity_estimate = 1;
-  c->conicity_min_confidence = 0.5;
-  c->conicity_fallback = 0.1358;
+  c->conicity_max_se = 0.01;
+  c->conicity_fallback = 0.0;
 }
 
 hm_status hm_alarm_config_validate(const hm_alarm_config *c, char *why, size_t len) {
@@ -59,61 +63,124 @@ hm_status hm_alarm_config_validate(const hm_alarm_config *c, char *why, size_t l
   if (!c) return HM_EINVAL;
   if (!(c->warn_amplitude_fraction > 0.0 && c->warn_amplitude_fraction < 1.0))
     field = "warn_amplitude_fraction", got = c->warn_amplitude_fraction;
-  else if (!(c->warn_speed_margin_kmh >= 0.0) || !isfinite(c->warn_speed_margin_kmh))
+  else if (!(c->warn_speed_margin_kmh >= 0.0 && c->warn_speed_margin_kmh <= 500.0))
     field = "warn_speed_margin_kmh", got = c->warn_speed_margin_kmh;
-  else if (!(c->hysteresis_kmh >= 0.0) || !isfinite(c->hysteresis_kmh))
+  else if (!(c->watch_speed_margin_kmh >= c->warn_speed_margin_kmh && c->watch_speed_margin_kmh <= 500.0))
+    field = "watch_speed_margin_kmh", got = c->watch_speed_margin_kmh;
+  else if (!(c->hysteresis_kmh >= 0.0 && c->hysteresis_kmh <= 100.0))
     field = "hysteresis_kmh", got = c->hysteresis_kmh;
   else if (!(c->hysteresis_amplitude_fraction >= 0.0 && c->hysteresis_amplitude_fraction < c->warn_amplitude_fraction))
     field = "hysteresis_amplitude_fraction", got = c->hysteresis_amplitude_fraction;
-  else if (!(c->min_hold_s >= 0.0) || !isfinite(c->min_hold_s))
+  else if (!(c->min_hold_s >= 0.0 && c->min_hold_s <= 3600.0))
     field = "min_hold_s", got = c->min_hold_s;
-  else if (!(c->conicity_min_confidence >= 0.0 && c->conicity_min_confidence <= 1.0))
-    field = "conicity_min_confidence", got = c->conicity_min_confidence;
-  else if (!(c->conicity_fallback > 0.0) || !isfinite(c->conicity_fallback))
+  else if (!(c->conicity_max_se > 0.0 && c->conicity_max_se <= 1.0))
+    field = "conicity_max_se", got = c->conicity_max_se;
+  else if (!(c->conicity_fallback >= 0.0 && c->conicity_fallback <= 10.0))
     field = "conicity_fallback", got = c->conicity_fallback;
   if (!field) return HM_OK;
   if (why && len) snprintf(why, len, "%s: out of range (got %g)", field, got);
   return HM_EDOMAIN;
 }
 
-hm_alarm hm_alarm_create(const hm_alarm_config *cfg, const hm_table table) {
-  if (!cfg || !table || hm_alarm_config_validate(cfg, NULL, 0) != HM_OK) return NULL;
+hm_status hm_alarm_create(const hm_alarm_config *cfg, const hm_vehicle *veh, const hm_table table, hm_alarm *out,
+                          char *why, size_t why_len) {
+  if (!cfg || !veh || !table || !out) return HM_EINVAL;
+  hm_status st = hm_alarm_config_validate(cfg, why, why_len);
+  if (st != HM_OK) return st;
   hm_alarm a = calloc(1, sizeof *a);
-  if (!a) return NULL;
+  if (!a) return HM_ENOMEM;
   a->cfg = *cfg;
+  if (a->cfg.conicity_fallback == 0.0) hm_conicity_eval(&veh->conicity, 0.0, &a->cfg.conicity_fallback, NULL);
   a->table = table;
   a->level = HM_LEVEL_NO_DATA;
   a->reason = HM_REASON_STARTUP;
-  return a;
+  *out = a;
+  return HM_OK;
 }
 
 void hm_alarm_destroy(hm_alarm a) { free(a); }
 
+void hm_alarm_reset(hm_alarm a) {
+  if (!a) return;
+  a->level = HM_LEVEL_NO_DATA;
+  a->reason = HM_REASON_STARTUP;
+  a->since = 0.0;
+  a->lower_pending = 0;
+  a->have_lookup = 0;
+}
+
 /* The level the conditions call for, with the thresholds of levels at or below `current` relaxed. */
-static hm_level raw_level(const hm_alarm a, const hm_estimate *e, const hm_assessment *s, hm_level current,
-                          hm_reason *reason) {
+static hm_level raw_level(const hm_alarm a, const hm_estimate *e, const hm_margin_estimate *g, const hm_assessment *s,
+                          hm_level current, hm_reason *reason) {
   const hm_alarm_config *c = &a->cfg;
-  const hm_table_lookup_result *b = &s->boundaries;
-  const double v = e->speed_kmh, amp = s->amplitude_m;
+  const double v = e->speed_kmh, amp = s->amplitude_m, edge = s->edge_used_m;
   const double hv_alarm = current >= HM_LEVEL_ALARM ? c->hysteresis_kmh : 0.0;
   const double hv_warn = current >= HM_LEVEL_WARN ? c->hysteresis_kmh : 0.0;
   const double hv_watch = current >= HM_LEVEL_WATCH ? c->hysteresis_kmh : 0.0;
   const double ha_alarm = current >= HM_LEVEL_ALARM ? c->hysteresis_amplitude_fraction : 0.0;
   const double ha_warn = current >= HM_LEVEL_WARN ? c->hysteresis_amplitude_fraction : 0.0;
-  const int edge = b->has_edge && b->edge_amp_m > 0.0;
   if (e->rms_exceeded) return *reason = HM_REASON_RMS_CRITERION, HM_LEVEL_ALARM;
   if (e->peaks_exceeded) return *reason = HM_REASON_PEAKS_CRITERION, HM_LEVEL_ALARM;
-  if (v >= b->hopf_speed_kmh - hv_alarm) return *reason = HM_REASON_ABOVE_HOPF, HM_LEVEL_ALARM;
-  if (edge && amp >= b->edge_amp_m * (1.0 - ha_alarm))
-    return *reason = HM_REASON_AMPLITUDE_BEYOND_EDGE, HM_LEVEL_ALARM;
-  if (edge && amp >= b->edge_amp_m * (c->warn_amplitude_fraction - ha_warn))
+  if (v > s->hopf_high_kmh - hv_alarm) return *reason = HM_REASON_ABOVE_HOPF, HM_LEVEL_ALARM;
+  if (edge > 0.0 && amp >= edge * (1.0 - ha_alarm)) return *reason = HM_REASON_AMPLITUDE_BEYOND_EDGE, HM_LEVEL_ALARM;
+  if (edge > 0.0 && amp >= edge * (c->warn_amplitude_fraction - ha_warn))
     return *reason = HM_REASON_AMPLITUDE_NEAR_EDGE, HM_LEVEL_WARN;
-  if (v >= b->hopf_speed_kmh - c->warn_speed_margin_kmh - hv_warn) return *reason = HM_REASON_NEAR_HOPF, HM_LEVEL_WARN;
-  if (v >= b->lowest_cycle_speed_kmh - hv_watch) return *reason = HM_REASON_BISTABLE_BAND, HM_LEVEL_WATCH;
-  return *reason = HM_REASON_BELOW_LOWEST_CYCLE, HM_LEVEL_OK;
+  if (v >= s->hopf_low_kmh - c->warn_speed_margin_kmh - hv_warn) return *reason = HM_REASON_NEAR_HOPF, HM_LEVEL_WARN;
+  if (v >= s->hopf_low_kmh - c->watch_speed_margin_kmh - hv_watch)
+    return *reason = HM_REASON_APPROACHING_HOPF, HM_LEVEL_WATCH;
+  if (g && g->model_mismatch) return *reason = HM_REASON_MODEL_MISMATCH, HM_LEVEL_WATCH;
+  if (e->sample_rate_mismatch) return *reason = HM_REASON_RATE_MISMATCH, HM_LEVEL_WATCH;
+  if (v < s->boundaries.lowest_cycle_speed_kmh) return *reason = HM_REASON_BELOW_LOWEST_CYCLE, HM_LEVEL_OK;
+  return *reason = HM_REASON_NORMAL, HM_LEVEL_OK;
 }
 
-hm_status hm_alarm_update(hm_alarm a, const hm_estimate *e, double now, hm_assessment *out) {
+/* The conicity in use, the Hopf interval and the boundaries at the current speed; the table's status on failure. */
+static hm_status assess(hm_alarm a, const hm_estimate *e, const hm_margin_estimate *g, hm_assessment *s) {
+  const hm_alarm_config *c = &a->cfg;
+  const int use = c->use_conicity_estimate && g && g->conicity_valid && g->hopf_model_valid &&
+                  g->conicity_se <= c->conicity_max_se;
+  s->conicity_from_estimate = use;
+  s->conicity = use ? g->conicity : c->conicity_fallback;
+  s->conicity_se = use ? g->conicity_se : 0.0;
+  hm_table_lookup_result b, bo;
+  if (a->have_lookup && a->lookup_conicity == s->conicity && a->lookup_speed == e->speed_kmh) {
+    b = a->lookup;
+  } else {
+    const hm_status st = hm_table_lookup(a->table, s->conicity, e->speed_kmh, &b);
+    if (st != HM_OK) return st;
+  }
+  if (use) {
+    s->hopf_low_kmh = g->hopf_model_low_kmh;
+    s->hopf_high_kmh = g->hopf_model_high_kmh;
+  } else {
+    s->hopf_low_kmh = b.hopf_speed_kmh - b.error_speed_kmh;
+    s->hopf_high_kmh = b.hopf_speed_kmh + b.error_speed_kmh;
+  }
+  s->boundaries = b;
+  /* the edge: at the conicity in use where the origin is stable there; inside the Hopf interval above the point
+   * estimate, at the interval's optimistic end (found by the lookup at the conicity whose Hopf speed is hopf_high,
+   * which the table's affine 1/V^2 makes exact) */
+  s->edge_used_m = b.has_edge ? b.edge_amp_m : 0.0;
+  if (!b.origin_stable && e->speed_kmh <= s->hopf_high_kmh && use) {
+    const double lambda_opt = g->conicity_low;
+    if (a->have_lookup && a->lookup_opt_conicity == lambda_opt && a->lookup_speed == e->speed_kmh) {
+      bo = a->lookup_opt;
+    } else {
+      const hm_status st = hm_table_lookup(a->table, lambda_opt, e->speed_kmh, &bo);
+      if (st != HM_OK) return st;
+    }
+    a->lookup_opt = bo;
+    a->lookup_opt_conicity = lambda_opt;
+    s->edge_used_m = bo.origin_stable && bo.has_edge ? bo.edge_amp_m : 0.0;
+  }
+  a->lookup = b;
+  a->lookup_conicity = s->conicity;
+  a->lookup_speed = e->speed_kmh;
+  a->have_lookup = 1;
+  return HM_OK;
+}
+
+hm_status hm_alarm_update(hm_alarm a, const hm_estimate *e, const hm_margin_estimate *g, double now, hm_assessment *out) {
   if (!a || !e || !out || !isfinite(now)) return HM_EINVAL;
   const hm_alarm_config *c = &a->cfg;
   hm_assessment s;
@@ -122,27 +189,18 @@ hm_status hm_alarm_update(hm_alarm a, const hm_estimate *e, double now, hm_asses
   hm_level target;
   if (!e->accel_valid || !e->speed_valid) {
     target = HM_LEVEL_NO_DATA;
-    reason = !e->accel_valid ? HM_REASON_NO_ACCEL : HM_REASON_NO_SPEED;
+    reason = !e->sample_rate_supported ? HM_REASON_BAD_SAMPLE_RATE
+             : !e->accel_valid         ? HM_REASON_NO_ACCEL
+                                       : HM_REASON_NO_SPEED;
   } else {
-    /* switch between the estimate and the fallback with hysteresis on the confidence, so that the boundaries
-     * do not jump back and forth with it */
-    const double need = a->using_estimate ? 0.5 * c->conicity_min_confidence : c->conicity_min_confidence;
-    a->using_estimate = c->use_conicity_estimate && e->conicity_valid && e->conicity_confidence >= need;
-    s.conicity_from_estimate = a->using_estimate;
-    s.conicity = s.conicity_from_estimate ? e->conicity : c->conicity_fallback;
-    if (!a->have_lookup || a->lookup_conicity != s.conicity || a->lookup_speed != e->speed_kmh) {
-      if (hm_table_lookup(a->table, s.conicity, e->speed_kmh, &a->lookup) != HM_OK) return HM_EINVAL;
-      a->have_lookup = 1;
-      a->lookup_conicity = s.conicity;
-      a->lookup_speed = e->speed_kmh;
-    }
-    s.boundaries = a->lookup;
+    const hm_status st = assess(a, e, g, &s);
+    if (st != HM_OK) return st;
     s.boundaries_valid = 1;
     s.margin_hopf_kmh = s.boundaries.hopf_speed_kmh - e->speed_kmh;
     s.margin_lowest_cycle_kmh = s.boundaries.lowest_cycle_speed_kmh - e->speed_kmh;
     s.amplitude_m = e->oscillation_valid ? e->amplitude_displacement_m : 0.0;
-    s.amplitude_margin_m = s.boundaries.has_edge ? s.boundaries.edge_amp_m - s.amplitude_m : 0.0;
-    target = raw_level(a, e, &s, a->level, &reason);
+    s.amplitude_margin_m = s.edge_used_m > 0.0 ? s.edge_used_m - s.amplitude_m : 0.0;
+    target = raw_level(a, e, g, &s, a->level, &reason);
   }
   s.changed = 0;
   if (target >= a->level || target == HM_LEVEL_NO_DATA || a->level == HM_LEVEL_NO_DATA) {

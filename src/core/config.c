@@ -298,7 +298,7 @@ hm_status hm_config_load_vehicle(const char *path, hm_vehicle *veh, char *name, 
 
 /* ---- monitor settings ---- */
 
-typedef enum { FIELD_DOUBLE, FIELD_UNSIGNED, FIELD_BOOL } field_type;
+typedef enum { FIELD_DOUBLE, FIELD_UNSIGNED, FIELD_BOOL, FIELD_POINT } field_type;
 
 typedef struct {
   const char *key;
@@ -306,102 +306,135 @@ typedef struct {
   size_t offset;
 } settings_field;
 
-#define EST(f, t) {#f, t, offsetof(hm_estimator_config, f)}
-#define ALM(f, t) {#f, t, offsetof(hm_alarm_config, f)}
+#define EST(f, t) {#f, t, offsetof(hm_monitor_config, estimator) + offsetof(hm_estimator_config, f)}
+#define MOD(f, t) {#f, t, offsetof(hm_monitor_config, modal) + offsetof(hm_modal_config, f)}
+#define MAR(f, t) {#f, t, offsetof(hm_monitor_config, margin) + offsetof(hm_margin_config, f)}
+#define ALM(f, t) {#f, t, offsetof(hm_monitor_config, alarm) + offsetof(hm_alarm_config, f)}
 
 static const settings_field estimator_fields[] = {
+    EST(measurement_point, FIELD_POINT),
     EST(sample_rate_hz, FIELD_DOUBLE),       EST(band_low_hz, FIELD_DOUBLE),
     EST(band_high_hz, FIELD_DOUBLE),         EST(tracking_time_s, FIELD_DOUBLE),
     EST(rms_window_m, FIELD_DOUBLE),         EST(rms_limit_mps2, FIELD_DOUBLE),
     EST(peaks_band_low_hz, FIELD_DOUBLE),    EST(peaks_band_high_hz, FIELD_DOUBLE),
     EST(peaks_limit_mps2, FIELD_DOUBLE),     EST(peaks_count, FIELD_UNSIGNED),
-    EST(conicity_min_speed_kmh, FIELD_DOUBLE), EST(conicity_min_amplitude_mps2, FIELD_DOUBLE),
-    EST(conicity_max_spread, FIELD_DOUBLE),  EST(conicity_min, FIELD_DOUBLE),
-    EST(conicity_max, FIELD_DOUBLE),         EST(conicity_time_s, FIELD_DOUBLE),
     EST(max_gap_s, FIELD_DOUBLE),
     EST(accel_timeout_s, FIELD_DOUBLE),      EST(speed_timeout_s, FIELD_DOUBLE),
     EST(max_speed_kmh, FIELD_DOUBLE),        EST(max_speed_rate_kmh_s, FIELD_DOUBLE),
+    EST(max_speed_jump_kmh, FIELD_DOUBLE),
     EST(max_accel_mps2, FIELD_DOUBLE),
+};
+
+static const settings_field modal_fields[] = {
+    MOD(window_s, FIELD_DOUBLE),       MOD(min_window_s, FIELD_DOUBLE), MOD(decimated_rate_hz, FIELD_DOUBLE),
+    MOD(band_low_hz, FIELD_DOUBLE),    MOD(band_high_hz, FIELD_DOUBLE), MOD(fit_interval_s, FIELD_DOUBLE),
+    MOD(tol, FIELD_DOUBLE),            MOD(max_iter, FIELD_UNSIGNED),
+};
+
+static const settings_field margin_fields[] = {
+    MAR(frequency_model_error, FIELD_DOUBLE), MAR(decay_rate_model_error, FIELD_DOUBLE),
+    MAR(max_speed_spread_kmh, FIELD_DOUBLE),  MAR(min_speed_kmh, FIELD_DOUBLE),
+    MAR(memory_s, FIELD_DOUBLE),              MAR(min_speed_span_kmh, FIELD_DOUBLE),
+    MAR(max_extrapolation_kmh, FIELD_DOUBLE), MAR(interval_z, FIELD_DOUBLE),
 };
 
 static const settings_field alarm_fields[] = {
     ALM(warn_amplitude_fraction, FIELD_DOUBLE), ALM(warn_speed_margin_kmh, FIELD_DOUBLE),
-    ALM(hysteresis_kmh, FIELD_DOUBLE),          ALM(hysteresis_amplitude_fraction, FIELD_DOUBLE),
+    ALM(watch_speed_margin_kmh, FIELD_DOUBLE),  ALM(hysteresis_kmh, FIELD_DOUBLE),
+    ALM(hysteresis_amplitude_fraction, FIELD_DOUBLE),
     ALM(min_hold_s, FIELD_DOUBLE),              ALM(use_conicity_estimate, FIELD_BOOL),
-    ALM(conicity_min_confidence, FIELD_DOUBLE), ALM(conicity_fallback, FIELD_DOUBLE),
+    ALM(conicity_max_se, FIELD_DOUBLE),         ALM(conicity_fallback, FIELD_DOUBLE),
 };
 
-/* Apply the keys of one section onto the struct at base. */
-static hm_status apply_section(parse_ctx *c, yaml_node_t *sec, const char *name, const settings_field *fields,
-                               size_t n_fields, void *base) {
-  if (sec->type != YAML_MAPPING_NODE) return fail(c, sec, HM_EPARSE, "%s: expected a mapping of keys", name);
-  for (yaml_node_pair_t *p = sec->data.mapping.pairs.start; p < sec->data.mapping.pairs.top; ++p) {
-    yaml_node_t *k = yaml_document_get_node(c->doc, p->key), *v = yaml_document_get_node(c->doc, p->value);
-    if (!k || k->type != YAML_SCALAR_NODE || !v) return fail(c, k, HM_EPARSE, "%s: keys must be plain names", name);
-    const settings_field *f = NULL;
-    for (size_t i = 0; i < n_fields && !f; ++i)
-      if (strcmp(fields[i].key, scalar_text(k)) == 0) f = &fields[i];
-    char path[96];
-    snprintf(path, sizeof path, "%s.%s", name, scalar_text(k));
-    if (!f) return fail(c, k, HM_EPARSE, "%s: unknown key", path);
-    if (f->type == FIELD_BOOL) {
-      const char *t = v->type == YAML_SCALAR_NODE ? scalar_text(v) : "";
-      const int yes = strcmp(t, "true") == 0, no = strcmp(t, "false") == 0;
-      if (!yes && !no) return fail(c, v, HM_EPARSE, "%s: expected true or false, got '%s'", path, t);
+static const struct {
+  const char *name;
+  const settings_field *fields;
+  size_t n;
+} sections[] = {{"estimator", estimator_fields, sizeof estimator_fields / sizeof estimator_fields[0]},
+                {"modal", modal_fields, sizeof modal_fields / sizeof modal_fields[0]},
+                {"margin", margin_fields, sizeof margin_fields / sizeof margin_fields[0]},
+                {"alarm", alarm_fields, sizeof alarm_fields / sizeof alarm_fields[0]}};
+
+/* One key's value into the field at base + f->offset. */
+static hm_status apply_field(parse_ctx *c, const settings_field *f, yaml_node_t *v, const char *path, void *base) {
+  const char *t = v->type == YAML_SCALAR_NODE ? scalar_text(v) : "";
+  if (f->type == FIELD_BOOL || f->type == FIELD_POINT) {
+    const char *yes_word = f->type == FIELD_BOOL ? "true" : "bogie_frame";
+    const char *no_word = f->type == FIELD_BOOL ? "false" : "wheelset";
+    const int yes = strcmp(t, yes_word) == 0, no = strcmp(t, no_word) == 0;
+    if (!yes && !no) return fail(c, v, HM_EPARSE, "%s: expected %s or %s, got '%s'", path, no_word, yes_word, t);
+    if (f->type == FIELD_BOOL)
       *(int *)((char *)base + f->offset) = yes;
-      continue;
-    }
-    double x = 0.0;
-    hm_status st = node_number(c, v, path, &x);
-    if (st != HM_OK) return st;
-    if (f->type == FIELD_UNSIGNED) {
-      if (x < 0.0 || x > 1e9 || x != floor(x)) return fail(c, v, HM_EPARSE, "%s: expected a whole number", path);
-      *(unsigned *)((char *)base + f->offset) = (unsigned)x;
-    } else {
-      *(double *)((char *)base + f->offset) = x;
-    }
+    else /* the criteria's defaults for that point first; explicit keys in the section then override them */
+      hm_estimator_config_criteria(&((hm_monitor_config *)base)->estimator,
+                                   yes ? HM_POINT_BOGIE_FRAME : HM_POINT_WHEELSET);
+    return HM_OK;
+  }
+  double x = 0.0;
+  hm_status st = node_number(c, v, path, &x);
+  if (st != HM_OK) return st;
+  if (f->type == FIELD_UNSIGNED) {
+    if (x < 0.0 || x > 1e9 || x != floor(x)) return fail(c, v, HM_EPARSE, "%s: expected a whole number", path);
+    *(unsigned *)((char *)base + f->offset) = (unsigned)x;
+  } else {
+    *(double *)((char *)base + f->offset) = x;
   }
   return HM_OK;
 }
 
-hm_status hm_config_parse_monitor(const char *text, size_t len, const char *source, hm_estimator_config *est,
-                                  hm_alarm_config *alarm, char *err, size_t err_len) {
-  if (!source) source = "<config>";
-  parse_ctx c = {NULL, source, err, err_len};
-  if (!text || !est || !alarm) return fail(&c, NULL, HM_EINVAL, "no text or no output");
-  yaml_document_t doc;
-  hm_status st0 = load_document(&c, text, len, &doc);
-  if (st0 != HM_OK) return st0;
-  hm_estimator_config e = *est;
-  hm_alarm_config a = *alarm;
-  hm_status st = HM_OK;
-  yaml_node_t *root = yaml_document_get_root_node(&doc);
-  if (!root || root->type != YAML_MAPPING_NODE) st = fail(&c, root, HM_EPARSE, "expected a mapping at the top level");
-  yaml_node_t *sec;
-  if (st == HM_OK && (sec = map_get(&c, root, "estimator")))
-    st = apply_section(&c, sec, "estimator", estimator_fields, sizeof estimator_fields / sizeof estimator_fields[0], &e);
-  if (st == HM_OK && (sec = map_get(&c, root, "alarm")))
-    st = apply_section(&c, sec, "alarm", alarm_fields, sizeof alarm_fields / sizeof alarm_fields[0], &a);
-  char why[160];
-  if (st == HM_OK && (st = hm_estimator_config_validate(&e, why, sizeof why)) != HM_OK)
-    fail(&c, NULL, st, "estimator.%s", why);
-  if (st == HM_OK && (st = hm_alarm_config_validate(&a, why, sizeof why)) != HM_OK) fail(&c, NULL, st, "alarm.%s", why);
-  yaml_document_delete(&doc);
-  if (st != HM_OK) return st;
-  *est = e;
-  *alarm = a;
+/* Apply the keys of one section onto cfg (measurement_point first: it sets the criteria's defaults). */
+static hm_status apply_section(parse_ctx *c, yaml_node_t *sec, const char *name, const settings_field *fields,
+                               size_t n_fields, hm_monitor_config *cfg) {
+  if (sec->type != YAML_MAPPING_NODE) return fail(c, sec, HM_EPARSE, "%s: expected a mapping of keys", name);
+  for (int pass = 0; pass < 2; ++pass)
+    for (yaml_node_pair_t *p = sec->data.mapping.pairs.start; p < sec->data.mapping.pairs.top; ++p) {
+      yaml_node_t *k = yaml_document_get_node(c->doc, p->key), *v = yaml_document_get_node(c->doc, p->value);
+      if (!k || k->type != YAML_SCALAR_NODE || !v) return fail(c, k, HM_EPARSE, "%s: keys must be plain names", name);
+      const settings_field *f = NULL;
+      for (size_t i = 0; i < n_fields && !f; ++i)
+        if (strcmp(fields[i].key, scalar_text(k)) == 0) f = &fields[i];
+      char path[96];
+      snprintf(path, sizeof path, "%s.%s", name, scalar_text(k));
+      if (!f) return fail(c, k, HM_EPARSE, "%s: unknown key", path);
+      if ((f->type == FIELD_POINT) != (pass == 0)) continue;
+      hm_status st = apply_field(c, f, v, path, cfg);
+      if (st != HM_OK) return st;
+    }
   return HM_OK;
 }
 
-hm_status hm_config_load_monitor(const char *path, hm_estimator_config *est, hm_alarm_config *alarm, char *err,
-                                 size_t err_len) {
+hm_status hm_config_parse_monitor(const char *text, size_t len, const char *source, hm_monitor_config *cfg, char *err,
+                                  size_t err_len) {
+  if (!source) source = "<config>";
+  parse_ctx c = {NULL, source, err, err_len};
+  if (!text || !cfg) return fail(&c, NULL, HM_EINVAL, "no text or no output");
+  yaml_document_t doc;
+  hm_status st0 = load_document(&c, text, len, &doc);
+  if (st0 != HM_OK) return st0;
+  hm_monitor_config m = *cfg;
+  hm_status st = HM_OK;
+  yaml_node_t *root = yaml_document_get_root_node(&doc);
+  if (!root || root->type != YAML_MAPPING_NODE) st = fail(&c, root, HM_EPARSE, "expected a mapping at the top level");
+  for (size_t i = 0; st == HM_OK && i < sizeof sections / sizeof sections[0]; ++i) {
+    yaml_node_t *sec = map_get(&c, root, sections[i].name);
+    if (sec) st = apply_section(&c, sec, sections[i].name, sections[i].fields, sections[i].n, &m);
+  }
+  char why[200];
+  if (st == HM_OK && (st = hm_monitor_config_validate(&m, why, sizeof why)) != HM_OK) fail(&c, NULL, st, "%s", why);
+  yaml_document_delete(&doc);
+  if (st != HM_OK) return st;
+  *cfg = m;
+  return HM_OK;
+}
+
+hm_status hm_config_load_monitor(const char *path, hm_monitor_config *cfg, char *err, size_t err_len) {
   parse_ctx c = {NULL, path ? path : "<null>", err, err_len};
   if (!path) return fail(&c, NULL, HM_EINVAL, "no path");
   char *buf = NULL;
   size_t n = 0;
   hm_status st = read_small_file(&c, path, &buf, &n);
   if (st != HM_OK) return st;
-  st = hm_config_parse_monitor(buf, n, path, est, alarm, err, err_len);
+  st = hm_config_parse_monitor(buf, n, path, cfg, err, err_len);
   free(buf);
   return st;
 }

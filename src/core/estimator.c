@@ -1,4 +1,4 @@
-/* Streaming estimator of the dominant lateral oscillation, the standard criteria and the conicity
+/* Streaming estimator of the dominant lateral oscillation and the standard criteria
  * (see estimator.h). No allocation after create. */
 #include "hunting_monitor/estimator.h"
 
@@ -8,51 +8,14 @@
 #include <string.h>
 
 #include "hunting_monitor/linear.h"
-
-/* ---- biquads (RBJ cookbook = bilinear transform pre-warped at the corner) ---- */
-
-typedef struct {
-  double b0, b1, b2, a1, a2, z1, z2;
-} biquad;
-
-static biquad biquad_design(int highpass, double f0, double q, double fs) {
-  const double w0 = 2.0 * HM_PI * f0 / fs, cw = cos(w0), alpha = sin(w0) / (2.0 * q), a0 = 1.0 + alpha;
-  biquad b;
-  memset(&b, 0, sizeof b);
-  b.b0 = (highpass ? (1.0 + cw) : (1.0 - cw)) / 2.0 / a0;
-  b.b1 = (highpass ? -(1.0 + cw) : (1.0 - cw)) / a0;
-  b.b2 = b.b0;
-  b.a1 = -2.0 * cw / a0;
-  b.a2 = (1.0 - alpha) / a0;
-  return b;
-}
-
-static inline double biquad_step(biquad *f, double x) {
-  const double y = f->b0 * x + f->z1;
-  f->z1 = f->b1 * x - f->a1 * y + f->z2;
-  f->z2 = f->b2 * x - f->a2 * y;
-  return y;
-}
-
-/* |H(e^{i theta})| of a biquad at theta = 2 pi f / fs. */
-static double biquad_gain(const biquad *f, double theta) {
-  const double c1 = cos(theta), s1 = sin(theta), c2 = cos(2.0 * theta), s2 = sin(2.0 * theta);
-  const double nr = f->b0 + f->b1 * c1 + f->b2 * c2, ni = -(f->b1 * s1 + f->b2 * s2);
-  const double dr = 1.0 + f->a1 * c1 + f->a2 * c2, di = -(f->a1 * s1 + f->a2 * s2);
-  return sqrt((nr * nr + ni * ni) / (dr * dr + di * di));
-}
-
-/* Butterworth Q factors: order 4 = two sections, order 2 = one. */
-static const double Q4[2] = {0.54119610014619698, 1.3065629648763766};
-static const double Q2 = 0.70710678118654752;
+#include "biquad.h"
 
 enum { BAND_SECTIONS = 4, PEAK_SECTIONS = 3 };
 
 struct hm_estimator_s {
   hm_estimator_config cfg;
-  hm_linear_coef coef;           /* of the vehicle, for the conicity inversion */
-  biquad band[BAND_SECTIONS];    /* HP4 + LP4 */
-  biquad peak[PEAK_SECTIONS];    /* HP2 + LP4 */
+  hm_biquad band[BAND_SECTIONS];    /* HP4 + LP4 */
+  hm_biquad peak[PEAK_SECTIONS];    /* HP2 + LP4 */
   /* sample history */
   int have_sample;
   double t_last, t_start;        /* last accepted sample, start of the current run (after a gap) */
@@ -73,15 +36,35 @@ struct hm_estimator_s {
   /* speed */
   int have_speed;
   double speed_kmh, t_speed;
-  /* conicity */
-  double sigma;                  /* last root real part of the inversion */
-  double conicity, conicity_conf, conicity_sens;
-  double f_slow, f_slow_periods; /* frequency averaged for the conicity, and how many periods it holds */
   /* the tracked oscillation as of the last crossing (the crossing ring changes only there) */
   double trk_f, trk_spread, trk_amp;
-  int conicity_ok;
   hm_estimate counters;          /* only the counters are used */
+  /* sample rate: the filters are designed for design_rate_hz, measured from the stamps over blocks of
+   * RATE_BLOCK_S; two blocks in a row off by more than RATE_REDESIGN_TOL redesign them */
+  double design_rate_hz, measured_rate_hz;
+  double blk_t0, blk_n;
+  int off_blocks;
+  unsigned long n_restarts;      /* filter restarts (gaps, redesigns, resets) */
 };
+
+enum { RATE_BLOCKS_TO_REDESIGN = 2 };
+static const double RATE_BLOCK_S = 0.5, RATE_REDESIGN_TOL = 0.02, RATE_MISMATCH_TOL = 0.05;
+
+void hm_estimator_config_criteria(hm_estimator_config *c, hm_measurement_point point) {
+  c->measurement_point = point;
+  if (point == HM_POINT_BOGIE_FRAME) { /* the standards' own limits, for the signal they were written for */
+    c->rms_limit_mps2 = 5.2;
+    c->peaks_band_low_hz = 0.5;
+    c->peaks_band_high_hz = 10.0;
+    c->peaks_limit_mps2 = 8.0;
+  } else { /* the wheelset: from the model (estimator.h) */
+    c->rms_limit_mps2 = 12.0;
+    c->peaks_band_low_hz = 2.0;
+    c->peaks_band_high_hz = 20.0;
+    c->peaks_limit_mps2 = 17.0;
+  }
+  c->peaks_count = 6;
+}
 
 void hm_estimator_config_default(hm_estimator_config *c) {
   c->sample_rate_hz = 2000.0;
@@ -89,22 +72,13 @@ void hm_estimator_config_default(hm_estimator_config *c) {
   c->band_high_hz = 20.0;
   c->tracking_time_s = 1.0;
   c->rms_window_m = 100.0;
-  c->rms_limit_mps2 = 5.2;
-  c->peaks_band_low_hz = 0.5;
-  c->peaks_band_high_hz = 10.0;
-  c->peaks_limit_mps2 = 8.0;
-  c->peaks_count = 6;
-  c->conicity_min_speed_kmh = 100.0;
-  c->conicity_min_amplitude_mps2 = 0.3;
-  c->conicity_max_spread = 0.05;
-  c->conicity_min = 0.01;
-  c->conicity_max = 1.0;
-  c->conicity_time_s = 10.0;
+  hm_estimator_config_criteria(c, HM_POINT_WHEELSET);
   c->max_gap_s = 0.05;
   c->accel_timeout_s = 0.2;
   c->speed_timeout_s = 1.0;
   c->max_speed_kmh = 600.0;
   c->max_speed_rate_kmh_s = 30.0;
+  c->max_speed_jump_kmh = 2.0;
   c->max_accel_mps2 = 500.0;
 }
 
@@ -126,10 +100,6 @@ hm_status hm_estimator_config_validate(const hm_estimator_config *c, char *why, 
                   {"rms_limit_mps2", c->rms_limit_mps2},
                   {"peaks_band_low_hz", c->peaks_band_low_hz},
                   {"peaks_limit_mps2", c->peaks_limit_mps2},
-                  {"conicity_min_amplitude_mps2", c->conicity_min_amplitude_mps2},
-                  {"conicity_max_spread", c->conicity_max_spread},
-                  {"conicity_min", c->conicity_min},
-                  {"conicity_time_s", c->conicity_time_s},
                   {"max_gap_s", c->max_gap_s},
                   {"accel_timeout_s", c->accel_timeout_s},
                   {"speed_timeout_s", c->speed_timeout_s},
@@ -147,11 +117,11 @@ hm_status hm_estimator_config_validate(const hm_estimator_config *c, char *why, 
                c->peaks_band_high_hz);
   if (c->tracking_time_s * c->band_low_hz < 1.0)
     return bad(why, len, "tracking_time_s", "must hold at least one period of band_low_hz", c->tracking_time_s);
+  if (!(c->max_speed_jump_kmh >= 0.0 && c->max_speed_jump_kmh <= 100.0))
+    return bad(why, len, "max_speed_jump_kmh", "must be in 0..100", c->max_speed_jump_kmh);
+  if (c->measurement_point != HM_POINT_WHEELSET && c->measurement_point != HM_POINT_BOGIE_FRAME)
+    return bad(why, len, "measurement_point", "must be wheelset or bogie_frame", (double)c->measurement_point);
   if (c->peaks_count < 1 || c->peaks_count > 1000) return bad(why, len, "peaks_count", "must be 1..1000", c->peaks_count);
-  if (!isfinite(c->conicity_min_speed_kmh) || c->conicity_min_speed_kmh < 0.0)
-    return bad(why, len, "conicity_min_speed_kmh", "must be finite and >= 0", c->conicity_min_speed_kmh);
-  if (!(c->conicity_max > c->conicity_min) || !isfinite(c->conicity_max))
-    return bad(why, len, "conicity_max", "must be finite and above conicity_min", c->conicity_max);
   if (c->max_gap_s < 2.0 / fs) return bad(why, len, "max_gap_s", "must be at least two sample periods", c->max_gap_s);
   /* upper bounds: the buffers are sized from these (estimator.h states the memory they bound) */
   const struct {
@@ -159,7 +129,6 @@ hm_status hm_estimator_config_validate(const hm_estimator_config *c, char *why, 
     double v, max;
   } bounded[] = {{"tracking_time_s", c->tracking_time_s, HM_ESTIMATOR_MAX_TRACKING_S},
                  {"rms_window_m", c->rms_window_m, HM_ESTIMATOR_MAX_RMS_WINDOW_M},
-                 {"conicity_time_s", c->conicity_time_s, 3600.0},
                  {"max_gap_s", c->max_gap_s, 10.0},
                  {"accel_timeout_s", c->accel_timeout_s, 60.0},
                  {"speed_timeout_s", c->speed_timeout_s, 60.0}};
@@ -174,14 +143,15 @@ hm_status hm_estimator_config_validate(const hm_estimator_config *c, char *why, 
 /* Filters, trackers and the r.m.s. window restart (after a gap or at reset); speed and counters stay. */
 static void restart_signal(hm_estimator e) {
   const hm_estimator_config *c = &e->cfg;
-  const double fs = c->sample_rate_hz;
-  e->band[0] = biquad_design(1, c->band_low_hz, Q4[0], fs);
-  e->band[1] = biquad_design(1, c->band_low_hz, Q4[1], fs);
-  e->band[2] = biquad_design(0, c->band_high_hz, Q4[0], fs);
-  e->band[3] = biquad_design(0, c->band_high_hz, Q4[1], fs);
-  e->peak[0] = biquad_design(1, c->peaks_band_low_hz, Q2, fs);
-  e->peak[1] = biquad_design(0, c->peaks_band_high_hz, Q4[0], fs);
-  e->peak[2] = biquad_design(0, c->peaks_band_high_hz, Q4[1], fs);
+  e->n_restarts++;
+  const double fs = e->design_rate_hz;
+  e->band[0] = hm_biquad_design(1, c->band_low_hz, HM_BUTTERWORTH_Q4[0], fs);
+  e->band[1] = hm_biquad_design(1, c->band_low_hz, HM_BUTTERWORTH_Q4[1], fs);
+  e->band[2] = hm_biquad_design(0, c->band_high_hz, HM_BUTTERWORTH_Q4[0], fs);
+  e->band[3] = hm_biquad_design(0, c->band_high_hz, HM_BUTTERWORTH_Q4[1], fs);
+  e->peak[0] = hm_biquad_design(1, c->peaks_band_low_hz, HM_BUTTERWORTH_Q2, fs);
+  e->peak[1] = hm_biquad_design(0, c->peaks_band_high_hz, HM_BUTTERWORTH_Q4[0], fs);
+  e->peak[2] = hm_biquad_design(0, c->peaks_band_high_hz, HM_BUTTERWORTH_Q4[1], fs);
   e->have_sample = 0;
   e->x_prev = 0.0;
   e->ms = 0.0;
@@ -195,20 +165,48 @@ static void restart_signal(hm_estimator e) {
   e->p_prev = 0.0;
   e->half_peak = 0.0;
   e->consecutive = 0;
+  e->blk_n = 0.0;
+  e->off_blocks = 0;
 }
 
-hm_estimator hm_estimator_create(const hm_estimator_config *cfg, const hm_vehicle *veh) {
-  if (!cfg || !veh || hm_estimator_config_validate(cfg, NULL, 0) != HM_OK ||
-      hm_vehicle_validate(veh, NULL, 0) != HM_OK)
-    return NULL;
+/* The rate the filters can be designed for: the bands below 0.45 of it, and 100..5000 Hz. */
+static int rate_supported(const hm_estimator_config *c, double fs) {
+  return fs >= 100.0 && fs <= 5000.0 && c->band_high_hz < 0.45 * fs && c->peaks_band_high_hz < 0.45 * fs;
+}
+
+/* Called per accepted sample after a first one, with no gap since the last: block rate measurement, and a
+ * redesign on a lasting change (the stream at another rate than configured: filters designed for the wrong
+ * rate put the band elsewhere, issue #9 item 5). */
+static void measure_rate(hm_estimator e, double t) {
+  if (e->blk_n == 0.0) e->blk_t0 = e->t_last;
+  e->blk_n += 1.0;
+  const double span = t - e->blk_t0;
+  if (span < RATE_BLOCK_S) return;
+  e->measured_rate_hz = e->blk_n / span;
+  e->blk_n = 0.0;
+  const int off = fabs(e->measured_rate_hz / e->design_rate_hz - 1.0) > RATE_REDESIGN_TOL;
+  e->off_blocks = off ? e->off_blocks + 1 : 0;
+  if (e->off_blocks >= RATE_BLOCKS_TO_REDESIGN && rate_supported(&e->cfg, e->measured_rate_hz)) {
+    e->design_rate_hz = e->measured_rate_hz;
+    e->counters.n_rate_changes++;
+    const double t_keep = e->t_last;
+    restart_signal(e); /* the filters' state belongs to the old design */
+    e->t_last = t_keep;
+  }
+}
+
+hm_status hm_estimator_create(const hm_estimator_config *cfg, hm_estimator *out, char *why, size_t why_len) {
+  if (!cfg || !out) return HM_EINVAL;
+  const hm_status st = hm_estimator_config_validate(cfg, why, why_len);
+  if (st != HM_OK) return st;
   hm_estimator e = calloc(1, sizeof *e);
-  if (!e) return NULL;
+  if (!e) return HM_ENOMEM;
   e->cfg = *cfg;
-  hm_linear_coef_from_vehicle(veh, &e->coef);
   /* crossings in one tracking time at the top of the band, with room to spare */
   e->cross_cap = (size_t)ceil(cfg->band_high_hz * cfg->tracking_time_s * 2.0) + 8;
   /* the r.m.s. window holds rms_window_m down to 30 km/h (and at least one second) */
-  e->ring_cap = (size_t)ceil(cfg->sample_rate_hz * fmax(cfg->rms_window_m / (30.0 / 3.6), 1.0)) + 1;
+  /* sized for the highest supported rate, since the filters follow the measured rate */
+  e->ring_cap = (size_t)ceil(5000.0 * fmax(cfg->rms_window_m / (30.0 / 3.6), 1.0)) + 1;
   e->cross = malloc(e->cross_cap * sizeof(double));
   e->cross_sum = malloc(e->cross_cap * sizeof(double));
   e->cross_count = malloc(e->cross_cap * sizeof(double));
@@ -216,10 +214,17 @@ hm_estimator hm_estimator_create(const hm_estimator_config *cfg, const hm_vehicl
   e->dist = malloc(e->ring_cap * sizeof(double));
   if (!e->cross || !e->cross_sum || !e->cross_count || !e->sq || !e->dist) {
     hm_estimator_destroy(e);
-    return NULL;
+    return HM_ENOMEM;
   }
   hm_estimator_reset(e);
-  return e;
+  *out = e;
+  return HM_OK;
+}
+
+unsigned long hm_estimator_restarts(const hm_estimator e, double *design_rate_hz) {
+  if (!e) return 0;
+  if (design_rate_hz) *design_rate_hz = e->design_rate_hz;
+  return e->n_restarts;
 }
 
 void hm_estimator_destroy(hm_estimator e) {
@@ -234,16 +239,12 @@ void hm_estimator_destroy(hm_estimator e) {
 
 void hm_estimator_reset(hm_estimator e) {
   if (!e) return;
+  e->design_rate_hz = e->cfg.sample_rate_hz;
+  e->measured_rate_hz = 0.0;
   restart_signal(e);
   e->have_speed = 0;
   e->speed_kmh = 0.0;
   e->t_speed = 0.0;
-  e->sigma = 0.0;
-  e->conicity = 0.0;
-  e->conicity_conf = 0.0;
-  e->conicity_sens = 0.0;
-  e->f_slow = e->f_slow_periods = 0.0;
-  e->conicity_ok = 0;
   memset(&e->counters, 0, sizeof e->counters);
 }
 
@@ -255,7 +256,7 @@ void hm_estimator_reset(hm_estimator e) {
 static double amplitude_from(const hm_estimator e, double ms, double f) {
   double gain = 1.0;
   if (f > 0.0)
-    for (int k = 0; k < BAND_SECTIONS; ++k) gain *= biquad_gain(&e->band[k], 2.0 * HM_PI * f / e->cfg.sample_rate_hz);
+    for (int k = 0; k < BAND_SECTIONS; ++k) gain *= hm_biquad_gain(&e->band[k], 2.0 * HM_PI * f / e->design_rate_hz);
   return sqrt(2.0 * fmax(ms, 0.0)) / fmax(gain, 1e-3);
 }
 
@@ -305,69 +306,6 @@ static double tracked(const hm_estimator e, double *spread, double *amp) {
   const double f = crossing_frequency(e, spread, &ms);
   *amp = amplitude_from(e, ms, f);
   return f;
-}
-
-/* lambda from (speed, frequency) through the linear hunting mode (see the header); 0 if it fails. */
-static int invert_conicity(hm_estimator e, double speed_kmh, double f_hz, double *lambda) {
-  const hm_linear_coef *c = &e->coef;
-  const double v = hm_mps_from_kmh(speed_kmh), w = 2.0 * HM_PI * f_hz;
-  const double c1 = c->c_lat_m_s2 / v, c2 = c->c_yaw_m_s2 / v, ge = c->c_lat_m_s2 * c->e_yaw_m_s2;
-  double sigma = isfinite(e->sigma) && fabs(e->sigma) < 1e3 ? e->sigma : 0.0;
-  for (int it = 0; it < 40; ++it) {
-    /* P1 = s^2 + c1 s + a, P2 = s^2 + c2 s + b at s = sigma + i w; q = P1 P2, q' = P1' P2 + P1 P2' */
-    const double sr = sigma, si = w, s2r = sr * sr - si * si, s2i = 2.0 * sr * si;
-    const double p1r = s2r + c1 * sr + c->k_lat_s2, p1i = s2i + c1 * si;
-    const double p2r = s2r + c2 * sr + c->k_yaw_s2, p2i = s2i + c2 * si;
-    const double d1r = 2.0 * sr + c1, d1i = 2.0 * si, d2r = 2.0 * sr + c2, d2i = 2.0 * si;
-    const double qr = p1r * p2r - p1i * p2i, qi = p1r * p2i + p1i * p2r;
-    const double dqi = (d1r * p2i + d1i * p2r) + (p1r * d2i + p1i * d2r);
-    if (dqi == 0.0 || !isfinite(dqi)) return 0;
-    const double step = qi / dqi;
-    sigma -= step;
-    if (fabs(step) <= 1e-12 * (1.0 + fabs(sigma))) {
-      const double l = -qr / ge;
-      if (!isfinite(l)) return 0;
-      e->sigma = sigma;
-      *lambda = l;
-      return 1;
-    }
-  }
-  return 0;
-}
-
-static void update_conicity(hm_estimator e, double t) {
-  const hm_estimator_config *c = &e->cfg;
-  const double f = e->trk_f, spread = e->trk_spread, a = e->trk_amp;
-  const int speed_ok = e->have_speed && t - e->t_speed <= c->speed_timeout_s &&
-                       e->speed_kmh >= c->conicity_min_speed_kmh && e->speed_kmh > 0.0;
-  const int settled = t - e->t_start >= c->tracking_time_s;
-  if (!(settled && speed_ok && f > 0.0 && a >= c->conicity_min_amplitude_mps2 && spread <= c->conicity_max_spread)) {
-    e->conicity_ok = 0;
-    e->conicity_conf = 0.0;
-    e->f_slow_periods = 0.0;
-    return;
-  }
-  /* the frequency averaged over conicity_time_s (one update per crossing): a plain running mean until that many
-   * periods are in, then an exponential average with the same memory, then inverted */
-  e->f_slow_periods = fmin(e->f_slow_periods + 1.0, fmax(1.0, f * c->conicity_time_s));
-  e->f_slow += (f - e->f_slow) / e->f_slow_periods;
-  double lambda = 0.0, lambda_up = 0.0;
-  const double sigma_before = e->sigma;
-  if (!invert_conicity(e, e->speed_kmh, e->f_slow * 1.001, &lambda_up) ||
-      !invert_conicity(e, e->speed_kmh, e->f_slow, &lambda) || lambda < c->conicity_min || lambda > c->conicity_max) {
-    e->sigma = sigma_before;
-    e->conicity_ok = 0;
-    e->conicity_conf = 0.0;
-    return;
-  }
-  /* sensitivity, and the expected relative error: S times the standard error of the averaged frequency */
-  const double S = fabs((lambda_up - lambda) / lambda) / 1e-3;
-  const double expected = S * spread / sqrt(e->f_slow_periods);
-  const double strength = fmin(1.0, a / c->conicity_min_amplitude_mps2 - 1.0);
-  e->conicity_sens = S;
-  e->conicity_conf = fmax(0.0, strength) * fmax(0.0, 1.0 - expected / 0.10);
-  e->conicity = lambda;
-  e->conicity_ok = 1;
 }
 
 /* sliding sum over the last rms_window_m of track */
@@ -432,15 +370,16 @@ hm_status hm_estimator_push_accel(hm_estimator e, double t, double a) {
     e->counters.n_gaps++;
     restart_signal(e);
   }
-  const double dt = e->have_sample ? t - e->t_last : 1.0 / e->cfg.sample_rate_hz;
+  if (e->have_sample) measure_rate(e, t);
+  const double dt = e->have_sample ? t - e->t_last : 1.0 / e->design_rate_hz;
   if (!e->have_sample) e->t_start = t;
   e->have_sample = 1;
   e->t_last = t;
   e->counters.n_samples++;
   double x = a;
-  for (int k = 0; k < BAND_SECTIONS; ++k) x = biquad_step(&e->band[k], x);
+  for (int k = 0; k < BAND_SECTIONS; ++k) x = hm_biquad_step(&e->band[k], x);
   double p = a;
-  for (int k = 0; k < PEAK_SECTIONS; ++k) p = biquad_step(&e->peak[k], p);
+  for (int k = 0; k < PEAK_SECTIONS; ++k) p = hm_biquad_step(&e->peak[k], p);
   /* mean square with time constant tracking_time / 2 */
   e->ms += (1.0 - exp(-dt / (0.5 * e->cfg.tracking_time_s))) * (x * x - e->ms);
   /* up-crossings, armed once the signal went below -10% of the amplitude */
@@ -457,7 +396,6 @@ hm_status hm_estimator_push_accel(hm_estimator e, double t, double a) {
     if (e->cross_n < e->cross_cap) ++e->cross_n;
     e->armed = 0;
     e->trk_f = tracked(e, &e->trk_spread, &e->trk_amp);
-    update_conicity(e, t);
   }
   e->x_prev = x;
   const int speed_ok = e->have_speed && t - e->t_speed <= e->cfg.speed_timeout_s;
@@ -474,7 +412,7 @@ hm_status hm_estimator_push_speed(hm_estimator e, double t, double v) {
   if (ok && e->have_speed) {
     const double dt = t - e->t_speed;
     const int fresh = dt <= c->speed_timeout_s;
-    ok = dt > 0.0 && (!fresh || fabs(v - e->speed_kmh) <= c->max_speed_rate_kmh_s * dt + 1e-9);
+    ok = dt > 0.0 && (!fresh || fabs(v - e->speed_kmh) <= c->max_speed_rate_kmh_s * dt + c->max_speed_jump_kmh);
   }
   if (!ok) {
     e->counters.n_speed_rejected++;
@@ -491,7 +429,12 @@ void hm_estimator_read(const hm_estimator e, double now, hm_estimate *out) {
   const hm_estimator_config *c = &e->cfg;
   hm_estimate r = e->counters;
   r.time_s = e->have_sample ? e->t_last : 0.0;
-  r.accel_valid = e->have_sample && isfinite(now) && now - e->t_last <= c->accel_timeout_s && now >= e->t_last - 1.0;
+  r.sample_rate_hz = e->design_rate_hz;
+  r.sample_rate_measured_hz = e->measured_rate_hz;
+  r.sample_rate_mismatch = e->measured_rate_hz > 0.0 && fabs(e->measured_rate_hz / c->sample_rate_hz - 1.0) > RATE_MISMATCH_TOL;
+  r.sample_rate_supported = e->measured_rate_hz == 0.0 || rate_supported(c, e->measured_rate_hz);
+  r.accel_valid = e->have_sample && isfinite(now) && now - e->t_last <= c->accel_timeout_s && now >= e->t_last - 1.0 &&
+                  r.sample_rate_supported;
   r.speed_valid = e->have_speed && isfinite(now) && now - e->t_speed <= c->speed_timeout_s;
   r.speed_kmh = e->have_speed ? e->speed_kmh : 0.0;
   const double f = e->have_sample ? e->trk_f : 0.0, spread = e->trk_spread, amp = e->trk_amp;
@@ -507,9 +450,5 @@ void hm_estimator_read(const hm_estimator e, double now, hm_estimate *out) {
   r.rms_exceeded = r.rms_window_complete && r.rms_mps2 >= c->rms_limit_mps2;
   r.consecutive_peaks = e->consecutive;
   r.peaks_exceeded = e->consecutive >= c->peaks_count;
-  r.conicity_valid = e->conicity_ok && r.speed_valid && r.accel_valid;
-  r.conicity = e->conicity;
-  r.conicity_confidence = r.conicity_valid ? e->conicity_conf : 0.0;
-  r.conicity_sensitivity = e->conicity_ok ? e->conicity_sens : 0.0;
   *out = r;
 }

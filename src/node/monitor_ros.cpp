@@ -22,12 +22,6 @@ double finite(double x) { return std::isfinite(x) ? x : 0.0; }
 
 MonitorRos::MonitorRos(ros::NodeHandle nh, ros::NodeHandle pnh) : nh_(nh), pnh_(pnh), updater_(nh, pnh) {
   if (!loadParameters()) return;
-  est_ = hm_estimator_create(&est_cfg_, &vehicle_);
-  alarm_ = hm_alarm_create(&alarm_cfg_, table_);
-  if (!est_ || !alarm_) {
-    ROS_FATAL("hunting_monitor: cannot create the estimator or the alarm (out of memory)");
-    return;
-  }
   if (accel_type_ == "imu")
     accel_sub_ = nh_.subscribe("accel", 4000, &MonitorRos::onAccelImu, this, ros::TransportHints().tcpNoDelay());
   else
@@ -37,8 +31,8 @@ MonitorRos::MonitorRos(ros::NodeHandle nh, ros::NodeHandle pnh) : nh_(nh), pnh_(
   alarm_pub_ = nh_.advertise<std_msgs::UInt8>("hunting_alarm", 1, true);
   marker_pub_ = nh_.advertise<visualization_msgs::MarkerArray>("hunting_markers", 5);
   updater_.setHardwareID("hunting_monitor");
-  accel_min_hz_ = 0.9 * est_cfg_.sample_rate_hz;
-  accel_max_hz_ = 1.1 * est_cfg_.sample_rate_hz;
+  accel_min_hz_ = 0.9 * cfg_.estimator.sample_rate_hz;
+  accel_max_hz_ = 1.1 * cfg_.estimator.sample_rate_hz;
   accel_freq_.reset(new diagnostic_updater::FrequencyStatus(
       diagnostic_updater::FrequencyStatusParam(&accel_min_hz_, &accel_max_hz_, 0.0, 5)));
   updater_.add(*accel_freq_);
@@ -47,15 +41,11 @@ MonitorRos::MonitorRos(ros::NodeHandle nh, ros::NodeHandle pnh) : nh_(nh), pnh_(
   timer_ = nh_.createTimer(ros::Duration(1.0 / status_rate_hz_), &MonitorRos::onTimer, this);
   ok_ = true;
   ROS_INFO("hunting_monitor: ready (accel %s at %.0f Hz, speed in %s, status at %.1f Hz, table %s)",
-           accel_type_.c_str(), est_cfg_.sample_rate_hz, speed_unit_.c_str(), status_rate_hz_,
+           accel_type_.c_str(), cfg_.estimator.sample_rate_hz, speed_unit_.c_str(), status_rate_hz_,
            table_file_.c_str());
 }
 
-MonitorRos::~MonitorRos() {
-  hm_alarm_destroy(alarm_);
-  hm_estimator_destroy(est_);
-  hm_table_destroy(table_);
-}
+MonitorRos::~MonitorRos() { hm_monitor_destroy(monitor_); }
 
 bool MonitorRos::loadParameters() {
   char err[512] = "";
@@ -65,12 +55,10 @@ bool MonitorRos::loadParameters() {
     ROS_FATAL("hunting_monitor: %s", error.c_str());
     return false;
   }
-  hm_estimator_config_default(&est_cfg_);
-  hm_alarm_config_default(&alarm_cfg_);
-  hm_conicity_eval(&vehicle_.conicity, 0.0, &alarm_cfg_.conicity_fallback, nullptr);
-  const std::string monitor_yaml = sectionsAsYaml(pnh_, {"estimator", "alarm"});
-  if (hm_config_parse_monitor(monitor_yaml.c_str(), monitor_yaml.size(), "~ (monitor parameters)", &est_cfg_,
-                              &alarm_cfg_, err, sizeof err) != HM_OK) {
+  hm_monitor_config_default(&cfg_);
+  const std::string monitor_yaml = sectionsAsYaml(pnh_, {"estimator", "modal", "margin", "alarm"});
+  if (hm_config_parse_monitor(monitor_yaml.c_str(), monitor_yaml.size(), "~ (monitor parameters)", &cfg_, err,
+                              sizeof err) != HM_OK) {
     ROS_FATAL("hunting_monitor: %s", err);
     return false;
   }
@@ -96,38 +84,33 @@ bool MonitorRos::loadParameters() {
     ROS_FATAL("hunting_monitor: ~status_rate_hz must be in (0, 1000], got %g", status_rate_hz_);
     return false;
   }
-  if (table_file_.empty()) {  // compute on start (seconds); a file made with `hunting tables` starts at once
-    hm_table_spec spec;
-    hm_table_spec_default(&spec);
-    pnh_.param("table_conicity_min", spec.conicity_min, spec.conicity_min);
-    pnh_.param("table_conicity_max", spec.conicity_max, spec.conicity_max);
-    int n = static_cast<int>(spec.n_conicity);
+  // The start-up policy (table checked against the vehicle or computed for it, fallback conicity) is the core's.
+  hm_table table = nullptr;
+  if (table_file_.empty()) {  // computed on start (seconds); a file made with `hunting tables` starts at once
+    int n = 8;
     pnh_.param("table_n", n, 8);
-    spec.n_conicity = n > 0 ? static_cast<size_t>(n) : 0;
-    ROS_INFO("hunting_monitor: no ~table_file: computing the boundary tables (%d conicities)...", n);
-    const hm_status st = hm_table_build(&vehicle_, &spec, &table_);
-    if (st != HM_OK) {
-      ROS_FATAL("hunting_monitor: computing the boundary tables failed: %s (check ~table_conicity_min/max, ~table_n)",
-                hm_status_str(st));
+    if (n < 2 || n > 1000) {
+      ROS_FATAL("hunting_monitor: ~table_n must be 2..1000, got %d", n);
       return false;
     }
+    cfg_.table_n_conicity = static_cast<size_t>(n);
+    ROS_INFO("hunting_monitor: no ~table_file: computing the boundary tables (%d conicities)...", n);
     table_file_ = "(computed on start)";
-    return true;
-  }
-  if (hm_table_load_file(table_file_.c_str(), &table_, err, sizeof err) != HM_OK) {
+  } else if (hm_table_load_file(table_file_.c_str(), &table, err, sizeof err) != HM_OK) {
     ROS_FATAL("hunting_monitor: ~table_file: %s", err);
     return false;
   }
-  // a table made for another vehicle (or altered) would give wrong margins: the core checks it against the vehicle
-  if (hm_table_check_vehicle(table_, &vehicle_, HM_TABLE_CHECK_TOL_KMH, err, sizeof err) != HM_OK) {
-    ROS_FATAL("hunting_monitor: ~table_file %s is not for this vehicle: %s", table_file_.c_str(), err);
+  const hm_status st = hm_monitor_create(&cfg_, &vehicle_, table, &monitor_, err, sizeof err);
+  if (st != HM_OK) {
+    ROS_FATAL("hunting_monitor: %s%s: %s", table ? "~table_file " : "", table ? table_file_.c_str() : "",
+              *err ? err : hm_status_str(st));
     return false;
   }
   return true;
 }
 
 void MonitorRos::pushAccel(double t, double a) {
-  if (hm_estimator_push_accel(est_, t, a) == HM_OK) accel_freq_->tick();
+  if (hm_monitor_push_accel(monitor_, t, a) == HM_OK) accel_freq_->tick();
 }
 
 void MonitorRos::onAccelFloat(const std_msgs::Float64::ConstPtr& msg) {
@@ -141,18 +124,19 @@ void MonitorRos::onAccelImu(const sensor_msgs::Imu::ConstPtr& msg) {
 
 void MonitorRos::onSpeed(const std_msgs::Float64::ConstPtr& msg) {
   const double v = speed_unit_ == "mps" ? msg->data * 3.6 : msg->data;
-  hm_estimator_push_speed(est_, ros::Time::now().toSec(), v);
+  hm_monitor_push_speed(monitor_, ros::Time::now().toSec(), v);
 }
 
 void MonitorRos::onTimer(const ros::TimerEvent&) {
   const ros::Time now = ros::Time::now();
-  hm_estimate e;
-  hm_assessment s;
-  hm_estimator_read(est_, now.toSec(), &e);
-  if (hm_alarm_update(alarm_, &e, now.toSec(), &s) != HM_OK) return;
-  last_est_ = e;
-  last_ = s;
+  hm_monitor_status st;
+  if (hm_monitor_update(monitor_, now.toSec(), &st) != HM_OK) return;
+  last_ = st;
   have_last_ = true;
+  const hm_estimate& e = st.estimate;
+  const hm_assessment& s = st.assessment;
+  const hm_mode_estimate& md = st.mode;
+  const hm_margin_estimate& g = st.margin;
 
   hunting_monitor::HuntingStatus m;
   m.header.stamp = now;
@@ -163,13 +147,35 @@ void MonitorRos::onTimer(const ros::TimerEvent&) {
   m.reason = hm_reason_text(s.reason);
   m.speed_kmh = finite(e.speed_kmh);
   m.speed_valid = e.speed_valid;
-  m.conicity_estimate = finite(e.conicity);
-  m.conicity_confidence = finite(e.conicity_confidence);
-  m.conicity_valid = e.conicity_valid;
+  m.sample_rate_hz = finite(e.sample_rate_measured_hz);
+  m.sample_rate_mismatch = e.sample_rate_mismatch;
+  m.mode_valid = md.valid;
+  m.mode_frequency_hz = md.valid ? finite(md.frequency_hz) : 0.0;
+  m.mode_frequency_se_hz = md.valid ? finite(md.frequency_se_hz) : 0.0;
+  m.decay_rate_1_s = md.valid ? finite(md.decay_rate_1_s) : 0.0;
+  m.decay_rate_se_1_s = md.valid ? finite(md.decay_rate_se_1_s) : 0.0;
+  m.damping_ratio = md.valid ? finite(md.damping_ratio) : 0.0;
+  m.damping_ratio_se = md.valid ? finite(md.damping_ratio_se) : 0.0;
+  m.windows_used = g.n_windows;
+  m.conicity_valid = g.conicity_valid;
+  m.conicity_estimate = g.conicity_valid ? finite(g.conicity) : 0.0;
+  m.conicity_se = g.conicity_valid ? finite(g.conicity_se) : 0.0;
+  m.hopf_model_valid = g.hopf_model_valid;
+  m.hopf_model_kmh = g.hopf_model_valid ? finite(g.hopf_model_kmh) : 0.0;
+  m.hopf_model_kmh_low = g.hopf_model_valid ? finite(g.hopf_model_low_kmh) : 0.0;
+  m.hopf_model_kmh_high = g.hopf_model_valid ? finite(g.hopf_model_high_kmh) : 0.0;
+  m.hopf_free_valid = g.hopf_free_valid;
+  m.hopf_free_kmh = g.hopf_free_valid ? finite(g.hopf_free_kmh) : 0.0;
+  m.hopf_free_kmh_low = g.hopf_free_valid ? finite(g.hopf_free_low_kmh) : 0.0;
+  m.hopf_free_kmh_high = g.hopf_free_valid ? finite(g.hopf_free_high_kmh) : 0.0;
+  m.model_mismatch = g.model_mismatch;
   m.boundaries_valid = s.boundaries_valid;  // never a stale margin presented as current
   const hm_table_lookup_result& b = s.boundaries;
   m.conicity_used = s.boundaries_valid ? finite(s.conicity) : 0.0;
+  m.conicity_from_estimate = s.boundaries_valid && s.conicity_from_estimate;
   m.hopf_speed_kmh = s.boundaries_valid ? finite(b.hopf_speed_kmh) : 0.0;
+  m.hopf_speed_kmh_low = s.boundaries_valid ? finite(s.hopf_low_kmh) : 0.0;
+  m.hopf_speed_kmh_high = s.boundaries_valid ? finite(s.hopf_high_kmh) : 0.0;
   m.lower_fold_speed_kmh = s.boundaries_valid ? finite(b.lowest_cycle_speed_kmh) : 0.0;
   m.margin_to_hopf_kmh = s.boundaries_valid ? finite(s.margin_hopf_kmh) : 0.0;
   m.margin_to_lower_fold_kmh = s.boundaries_valid ? finite(s.margin_lowest_cycle_kmh) : 0.0;
@@ -177,8 +183,8 @@ void MonitorRos::onTimer(const ros::TimerEvent&) {
   m.amplitude_displacement_m = finite(e.amplitude_displacement_m);
   m.frequency_hz = finite(e.frequency_hz);
   m.oscillation_valid = e.oscillation_valid;
-  m.cycles_valid = s.boundaries_valid && b.has_edge;
-  m.unstable_cycle_amplitude_m = m.cycles_valid ? finite(b.edge_amp_m) : 0.0;
+  m.cycles_valid = s.boundaries_valid && s.edge_used_m > 0.0;
+  m.unstable_cycle_amplitude_m = m.cycles_valid ? finite(s.edge_used_m) : 0.0;
   m.stable_cycle_amplitude_m = s.boundaries_valid && b.has_stable_outer ? finite(b.stable_outer_amp_m) : 0.0;
   m.rms_accel_mps2 = finite(e.rms_mps2);
   m.consecutive_peaks = e.consecutive_peaks;
@@ -194,11 +200,13 @@ void MonitorRos::onTimer(const ros::TimerEvent&) {
     ROS_INFO("hunting_monitor: level %s (%s) at %.1f km/h", hm_level_name(s.level), hm_reason_text(s.reason),
              e.speed_kmh);
   }
-  publishMarkers(e, s, now);
+  publishMarkers(st, now);
   updater_.update();
 }
 
-void MonitorRos::publishMarkers(const hm_estimate& e, const hm_assessment& s, const ros::Time& now) {
+void MonitorRos::publishMarkers(const hm_monitor_status& st, const ros::Time& now) {
+  const hm_estimate& e = st.estimate;
+  const hm_assessment& s = st.assessment;
   static const float colours[5][3] = {{0.5f, 0.5f, 0.5f}, {0.1f, 0.8f, 0.1f}, {0.9f, 0.9f, 0.1f},
                                       {1.0f, 0.55f, 0.0f}, {0.9f, 0.1f, 0.1f}};
   const float* c = colours[static_cast<int>(s.level)];
@@ -224,15 +232,16 @@ void MonitorRos::publishMarkers(const hm_estimate& e, const hm_assessment& s, co
   text.scale.x = text.scale.y = 0.0;
   text.scale.z = 0.16;
   text.color.r = text.color.g = text.color.b = 1.0;
-  char buf[512];
+  char buf[512], decay[32] = "-";
+  if (st.mode.valid) std::snprintf(decay, sizeof decay, "%.2f 1/s", st.mode.decay_rate_1_s);
   if (s.boundaries_valid)
     std::snprintf(buf, sizeof buf,
-                  "%s: %s\nV %.1f km/h  Hopf %.1f (margin %.1f)  lowest cycle %.1f\n"
-                  "amplitude %.2f mm at %.1f Hz  unstable cycle %.2f mm\nconicity %.3f (%s)",
+                  "%s: %s\nV %.1f km/h  Hopf %.1f [%.1f, %.1f] (margin %.1f)  lowest cycle %.1f\n"
+                  "amplitude %.2f mm at %.1f Hz  unstable cycle %.2f mm\nconicity %.3f (%s)  decay %s",
                   hm_level_name(s.level), hm_reason_text(s.reason), e.speed_kmh, s.boundaries.hopf_speed_kmh,
-                  s.margin_hopf_kmh, s.boundaries.lowest_cycle_speed_kmh, 1e3 * e.amplitude_displacement_m,
-                  e.frequency_hz, s.boundaries.has_edge ? 1e3 * s.boundaries.edge_amp_m : 0.0, s.conicity,
-                  s.conicity_from_estimate ? "estimated" : "configured");
+                  s.hopf_low_kmh, s.hopf_high_kmh, s.margin_hopf_kmh, s.boundaries.lowest_cycle_speed_kmh,
+                  1e3 * e.amplitude_displacement_m, e.frequency_hz, 1e3 * s.edge_used_m, s.conicity,
+                  s.conicity_from_estimate ? "identified" : "configured", decay);
   else
     std::snprintf(buf, sizeof buf, "%s: %s", hm_level_name(s.level), hm_reason_text(s.reason));
   text.text = buf;
@@ -241,15 +250,25 @@ void MonitorRos::publishMarkers(const hm_estimate& e, const hm_assessment& s, co
 }
 
 void MonitorRos::diagnoseInputs(diagnostic_updater::DiagnosticStatusWrapper& stat) {
-  const hm_estimate& e = last_est_;
+  const hm_estimate& e = last_.estimate;
   if (!have_last_ || !e.accel_valid || !e.speed_valid)
     stat.summary(diagnostic_msgs::DiagnosticStatus::ERROR,
-                 !have_last_ ? "no data yet" : !e.accel_valid ? "acceleration stale or missing" : "speed stale or missing");
+                 !have_last_                ? "no data yet"
+                 : !e.sample_rate_supported ? "acceleration at a sample rate the filters cannot use"
+                 : !e.accel_valid           ? "acceleration stale or missing"
+                                            : "speed stale or missing");
+  else if (e.sample_rate_mismatch)
+    stat.summary(diagnostic_msgs::DiagnosticStatus::WARN,
+                 "acceleration at " + std::to_string(static_cast<int>(std::lround(e.sample_rate_measured_hz))) +
+                     " Hz, configured " + std::to_string(static_cast<int>(std::lround(cfg_.estimator.sample_rate_hz))) +
+                     " Hz: filters follow the measured rate");
   else if (e.n_rejected_nonfinite + e.n_rejected_range + e.n_rejected_order + e.n_speed_rejected + e.n_gaps > 0)
     stat.summary(diagnostic_msgs::DiagnosticStatus::WARN, "inputs current; some samples were rejected");
   else
     stat.summary(diagnostic_msgs::DiagnosticStatus::OK, "inputs current");
   stat.add("speed_kmh", e.speed_kmh);
+  stat.add("sample rate measured [Hz]", e.sample_rate_measured_hz);
+  stat.add("sample rate configured [Hz]", cfg_.estimator.sample_rate_hz);
   stat.add("samples", e.n_samples);
   stat.add("rejected non-finite", e.n_rejected_nonfinite);
   stat.add("rejected out of range", e.n_rejected_range);
@@ -257,19 +276,32 @@ void MonitorRos::diagnoseInputs(diagnostic_updater::DiagnosticStatusWrapper& sta
   stat.add("gaps", e.n_gaps);
   stat.add("rejected speeds", e.n_speed_rejected);
   stat.add("oscillation valid", static_cast<bool>(e.oscillation_valid));
-  stat.add("conicity confidence", e.conicity_confidence);
 }
 
 void MonitorRos::diagnoseLevel(diagnostic_updater::DiagnosticStatusWrapper& stat) {
-  const hm_level l = have_last_ ? last_.level : HM_LEVEL_NO_DATA;
+  const hm_assessment& s = last_.assessment;
+  const hm_level l = have_last_ ? s.level : HM_LEVEL_NO_DATA;
   const unsigned char d = l == HM_LEVEL_OK || l == HM_LEVEL_WATCH ? diagnostic_msgs::DiagnosticStatus::OK
                           : l == HM_LEVEL_WARN                       ? diagnostic_msgs::DiagnosticStatus::WARN
                                                                      : diagnostic_msgs::DiagnosticStatus::ERROR;
-  stat.summary(d, std::string(hm_level_name(l)) + ": " + hm_reason_text(have_last_ ? last_.reason : HM_REASON_STARTUP));
-  if (have_last_ && last_.boundaries_valid) {
-    stat.add("margin to Hopf [km/h]", last_.margin_hopf_kmh);
-    stat.add("margin to lowest cycle speed [km/h]", last_.margin_lowest_cycle_kmh);
-    stat.add("conicity used", last_.conicity);
+  stat.summary(d, std::string(hm_level_name(l)) + ": " + hm_reason_text(have_last_ ? s.reason : HM_REASON_STARTUP));
+  if (have_last_ && s.boundaries_valid) {
+    stat.add("margin to Hopf [km/h]", s.margin_hopf_kmh);
+    stat.add("Hopf interval low [km/h]", s.hopf_low_kmh);
+    stat.add("Hopf interval high [km/h]", s.hopf_high_kmh);
+    stat.add("margin to lowest cycle speed [km/h]", s.margin_lowest_cycle_kmh);
+    stat.add("conicity used", s.conicity);
+    stat.add("conicity from identification", static_cast<bool>(s.conicity_from_estimate));
+  }
+  const hm_margin_estimate& g = last_.margin;
+  if (have_last_) {
+    stat.add("identified windows", g.n_windows);
+    if (last_.mode.valid) {
+      stat.add("decay rate [1/s]", last_.mode.decay_rate_1_s);
+      stat.add("damping ratio", last_.mode.damping_ratio);
+    }
+    if (g.hopf_free_valid) stat.add("model-free Hopf [km/h]", g.hopf_free_kmh);
+    stat.add("model mismatch", static_cast<bool>(g.model_mismatch));
   }
 }
 

@@ -13,10 +13,8 @@
 #include <string>
 
 extern "C" {
-#include "hunting_monitor/alarm.h"
-#include "hunting_monitor/estimator.h"
 #include "hunting_monitor/model.h"
-#include "hunting_monitor/tables.h"
+#include "hunting_monitor/monitor.h"
 }
 
 namespace hunting_monitor {
@@ -35,7 +33,7 @@ class MonitorRos {
   void onSpeed(const std_msgs::Float64::ConstPtr& msg);
   void pushAccel(double t, double a);
   void onTimer(const ros::TimerEvent& ev);
-  void publishMarkers(const hm_estimate& e, const hm_assessment& s, const ros::Time& now);
+  void publishMarkers(const hm_monitor_status& st, const ros::Time& now);
   void diagnoseInputs(diagnostic_updater::DiagnosticStatusWrapper& stat);
   void diagnoseLevel(diagnostic_updater::DiagnosticStatusWrapper& stat);
 
@@ -45,15 +43,11 @@ class MonitorRos {
   std::string accel_type_, imu_axis_, speed_unit_, frame_id_, table_file_;
   double status_rate_hz_ = 20.0;
   hm_vehicle vehicle_{};
-  hm_estimator_config est_cfg_{};
-  hm_alarm_config alarm_cfg_{};
-  // core objects
-  hm_table table_ = nullptr;
-  hm_estimator est_ = nullptr;
-  hm_alarm alarm_ = nullptr;
+  hm_monitor_config cfg_{};
+  // the core's monitor (estimator, identification, margin, alarm, table)
+  hm_monitor monitor_ = nullptr;
   // last results, for diagnostics
-  hm_estimate last_est_{};
-  hm_assessment last_{};
+  hm_monitor_status last_{};
   bool have_last_ = false;
   int last_published_level_ = -1;
   // ROS

@@ -339,8 +339,9 @@ def lines(text):
 
 def test_simulate_streams_and_estimate_ramp_through_hopf():
     # A speed ramp 480 -> 530 km/h over 30 s through the Hopf speed (517.6 km/h) on a smooth irregular track:
-    # the monitor says WATCH in the bistable band first, ALARM at the latest once the Hopf speed is passed, and
-    # never shows margins without data.
+    # the monitor says OK first (480 km/h is in the bistable band, which is stated in the fields, not as a level),
+    # WATCH from 30 km/h below the Hopf interval (517.618 -+ the table's stated error), WARN from 10 km/h below it,
+    # ALARM at the latest once the Hopf speed is passed, and never shows margins without data.
     with tempfile.TemporaryDirectory() as d:
         acc, spd, tbl = (os.path.join(d, n) for n in ("a.csv", "s.csv", "t.tbl"))
         run("simulate", "--v", "480", "--v-end", "530", "--t", "30", "--irregularity", "0.01", "--dt-out", "0.0005",
@@ -352,7 +353,11 @@ def test_simulate_streams_and_estimate_ramp_through_hopf():
         out = lines(run("estimate", "--accel", acc, "--speed", spd, "--table", tbl, "--every", "0.5").stdout)
     assert len(out) >= 55, len(out)
     levels = [o["level"] for o in out]
-    assert levels[1] == "WATCH", levels
+    assert levels[1] == "OK" and out[1]["margin_lowest_cycle_kmh"] < 0, levels
+    for level, below in (("WATCH", 30.0), ("WARN", 10.0)):
+        first = next(o for o in out if o["level"] == level)
+        close(first["speed_kmh"], first["hopf_kmh_low"] - below, 1.0, f"speed at the first {level}")
+        close(first["hopf_kmh_low"], 517.618, 1.0, "lower end of the Hopf interval (MODEL.md section 7)")
     first_alarm = next(o for o in out if o["level"] == "ALARM")
     assert first_alarm["speed_kmh"] <= 517.618 + 3.0, first_alarm  # alarmed at the latest just past Hopf
     assert all(o["level"] == "ALARM" for o in out if o["speed_kmh"] >= 520.0), levels

@@ -61,11 +61,15 @@ class Replay(unittest.TestCase):
         seq = self.data_statuses()
         levels = [LEVELS[m.level] for m in seq]
         self.assertNotIn("NO_DATA", levels, "NO_DATA while data flows")
-        # OK below the lowest speed with a cycle (239.5 km/h, MODEL.md section 7), WATCH in the bistable band,
-        # ALARM at the latest just past the Hopf speed (517.6 km/h); the levels only go up along the ramp
+        # OK in the bistable band too (from 239.5 km/h, MODEL.md section 7: stated in the fields, not as a level),
+        # WATCH from 30 km/h below the Hopf interval (517.618 km/h -+ the shipped table's stated 0.48 km/h), WARN
+        # from 10 km/h below it, ALARM at the latest just past the Hopf speed; the levels only go up along the ramp
         self.assertEqual(levels[0], "OK")
+        self.assertTrue(any(m.level == HuntingStatus.LEVEL_OK and m.margin_to_lower_fold_kmh < 0 for m in seq))
         first_watch = next(m for m in seq if m.level == HuntingStatus.LEVEL_WATCH)
-        self.assertAlmostEqual(first_watch.speed_kmh, 239.5, delta=3.0)
+        self.assertAlmostEqual(first_watch.speed_kmh, 517.618 - 0.483 - 30.0, delta=1.0)
+        first_warn = next(m for m in seq if m.level == HuntingStatus.LEVEL_WARN)
+        self.assertAlmostEqual(first_warn.speed_kmh, 517.618 - 0.483 - 10.0, delta=1.0)
         first_alarm = next(m for m in seq if m.level == HuntingStatus.LEVEL_ALARM)
         self.assertLessEqual(first_alarm.speed_kmh, 517.618 + 3.0)
         self.assertTrue(all(m.level == HuntingStatus.LEVEL_ALARM for m in seq if m.speed_kmh >= 520.0))

@@ -7,6 +7,7 @@
 #include "hunting_monitor/linear.h"
 
 static hm_table table;
+static hm_vehicle vehicle;
 
 /* A current estimate at speed v with displacement amplitude amp [m] (no criterion met, no conicity estimate). */
 static hm_estimate estimate(double v, double amp) {
@@ -17,30 +18,38 @@ static hm_estimate estimate(double v, double amp) {
   e.oscillation_valid = amp > 0.0;
   e.amplitude_displacement_m = amp;
   e.frequency_hz = amp > 0.0 ? 14.0 : 0.0;
+  e.sample_rate_supported = 1;
   return e;
 }
 
 static hm_alarm make(void) {
   hm_alarm_config c;
   hm_alarm_config_default(&c);
-  return hm_alarm_create(&c, table);
+  hm_alarm a = NULL;
+  char why[128];
+  HM_CHECK(hm_alarm_create(&c, &vehicle, table, &a, why, sizeof why) == HM_OK, "create: %s", why);
+  return a;
 }
 
-/* Levels at the default vehicle's boundaries (lambda(0) = 0.1358: Hopf 517.618 km/h (closed form), lowest
- * cycle about 239.5 km/h, basin edge about 8.35 mm at 400 km/h - MODEL.md section 7). */
-static void levels_follow_the_boundaries(void) {
-  hm_vehicle v;
-  hm_vehicle_default(&v);
+static double hopf_closed_form(double conicity) {
   double vc;
-  hm_linear_critical_speed(&v, 0.1358, &vc);
-  const double hopf = hm_kmh_from_mps(vc);
+  hm_linear_critical_speed(&vehicle, conicity, &vc);
+  return hm_kmh_from_mps(vc);
+}
+
+/* Levels at the default vehicle's boundaries with the fallback conicity (the vehicle's lambda(0) = 0.1358: Hopf
+ * 517.618 km/h (closed form), lowest cycle about 239.5 km/h, basin edge about 8.35 mm at 400 km/h - MODEL.md
+ * section 7). 400 km/h is in the bistable band, and OK: the band is stated in the fields, not as a level. */
+static void levels_follow_the_boundaries(void) {
+  const double hopf = hopf_closed_form(0.1358);
   const struct {
     double v, amp;
     hm_level level;
     hm_reason reason;
   } cases[] = {
       {200.0, 0.0, HM_LEVEL_OK, HM_REASON_BELOW_LOWEST_CYCLE},
-      {400.0, 0.0, HM_LEVEL_WATCH, HM_REASON_BISTABLE_BAND},
+      {400.0, 0.0, HM_LEVEL_OK, HM_REASON_NORMAL},
+      {hopf - 25.0, 0.0, HM_LEVEL_WATCH, HM_REASON_APPROACHING_HOPF},
       {400.0, 0.005, HM_LEVEL_WARN, HM_REASON_AMPLITUDE_NEAR_EDGE},
       {400.0, 0.009, HM_LEVEL_ALARM, HM_REASON_AMPLITUDE_BEYOND_EDGE},
       {hopf - 5.0, 0.0, HM_LEVEL_WARN, HM_REASON_NEAR_HOPF},
@@ -50,22 +59,23 @@ static void levels_follow_the_boundaries(void) {
     hm_alarm a = make();
     hm_assessment s;
     const hm_estimate e = estimate(cases[i].v, cases[i].amp);
-    HM_CHECK(hm_alarm_update(a, &e, 10.0, &s) == HM_OK, "update");
+    HM_CHECK(hm_alarm_update(a, &e, NULL, 10.0, &s) == HM_OK, "update");
     HM_CHECK(s.level == cases[i].level && s.reason == cases[i].reason, "v %g amp %g: %s (%s)", cases[i].v,
              cases[i].amp, hm_level_name(s.level), hm_reason_text(s.reason));
     HM_CHECK(s.boundaries_valid && s.changed, "boundaries and change flag");
     HM_CHECK_DELTA(s.margin_hopf_kmh, hopf - cases[i].v, 1e-6, "margin to the Hopf speed");
+    HM_CHECK((s.margin_lowest_cycle_kmh < 0.0) == (cases[i].v > 250.0), "v %g: bistable band in the fields", cases[i].v);
     hm_alarm_destroy(a);
   }
   hm_estimate e = estimate(300.0, 0.0);
   e.rms_exceeded = 1;
   hm_alarm a = make();
   hm_assessment s;
-  hm_alarm_update(a, &e, 0.0, &s);
+  hm_alarm_update(a, &e, NULL, 0.0, &s);
   HM_CHECK(s.level == HM_LEVEL_ALARM && s.reason == HM_REASON_RMS_CRITERION, "r.m.s. criterion");
   e.rms_exceeded = 0;
   e.peaks_exceeded = 1;
-  hm_alarm_update(a, &e, 0.1, &s);
+  hm_alarm_update(a, &e, NULL, 0.1, &s);
   HM_CHECK(s.level == HM_LEVEL_ALARM && s.reason == HM_REASON_PEAKS_CRITERION && !s.changed, "peaks criterion");
   hm_alarm_destroy(a);
 }
@@ -75,18 +85,18 @@ static void stale_input_is_no_data(void) {
   hm_alarm a = make();
   hm_assessment s;
   hm_estimate e = estimate(520.0, 0.0);
-  hm_alarm_update(a, &e, 0.0, &s);
+  hm_alarm_update(a, &e, NULL, 0.0, &s);
   HM_CHECK(s.level == HM_LEVEL_ALARM, "alarm");
   e.speed_valid = 0;
-  hm_alarm_update(a, &e, 0.1, &s);
+  hm_alarm_update(a, &e, NULL, 0.1, &s);
   HM_CHECK(s.level == HM_LEVEL_NO_DATA && s.reason == HM_REASON_NO_SPEED && !s.boundaries_valid && s.changed,
            "stale speed: %s", hm_level_name(s.level));
   e.speed_valid = 1;
   e.accel_valid = 0;
-  hm_alarm_update(a, &e, 0.2, &s);
+  hm_alarm_update(a, &e, NULL, 0.2, &s);
   HM_CHECK(s.level == HM_LEVEL_NO_DATA && s.reason == HM_REASON_NO_ACCEL, "stale acceleration");
   e = estimate(200.0, 0.0);
-  hm_alarm_update(a, &e, 0.3, &s);
+  hm_alarm_update(a, &e, NULL, 0.3, &s);
   HM_CHECK(s.level == HM_LEVEL_OK && s.changed, "data back: %s", hm_level_name(s.level));
   hm_alarm_destroy(a);
 }
@@ -94,25 +104,21 @@ static void stale_input_is_no_data(void) {
 /* Hysteresis and hold: from ALARM (above Hopf) down to 3 km/h below it the level stays ALARM; further down it
  * falls to WARN only after 3 s; a speed dithering around the WARN threshold changes the level once. */
 static void hysteresis_and_hold_prevent_chatter(void) {
-  hm_vehicle v;
-  hm_vehicle_default(&v);
-  double vc;
-  hm_linear_critical_speed(&v, 0.1358, &vc);
-  const double hopf = hm_kmh_from_mps(vc);
+  const double hopf = hopf_closed_form(0.1358);
   hm_alarm a = make();
   hm_assessment s;
   hm_estimate e = estimate(hopf + 1.0, 0.0);
-  hm_alarm_update(a, &e, 0.0, &s);
+  hm_alarm_update(a, &e, NULL, 0.0, &s);
   HM_CHECK(s.level == HM_LEVEL_ALARM, "alarm above Hopf");
   e = estimate(hopf - 2.0, 0.0); /* inside the 3 km/h hysteresis */
   for (double t = 0.1; t < 10.0; t += 0.1) {
-    hm_alarm_update(a, &e, t, &s);
+    hm_alarm_update(a, &e, NULL, t, &s);
     HM_CHECK(s.level == HM_LEVEL_ALARM, "t %g: %s inside the hysteresis", t, hm_level_name(s.level));
   }
   e = estimate(hopf - 5.0, 0.0);
   double changed_at = -1.0;
   for (double t = 10.0; t < 20.0; t += 0.1) {
-    hm_alarm_update(a, &e, t, &s);
+    hm_alarm_update(a, &e, NULL, t, &s);
     if (s.changed && changed_at < 0.0) changed_at = t;
   }
   HM_CHECK(s.level == HM_LEVEL_WARN && s.reason == HM_REASON_NEAR_HOPF, "down to WARN: %s", hm_level_name(s.level));
@@ -121,7 +127,7 @@ static void hysteresis_and_hold_prevent_chatter(void) {
   int changes = 0;
   for (int k = 0; k < 200; ++k) {
     e = estimate(hopf - 10.0 + (k % 2 ? 0.5 : -0.5), 0.0);
-    hm_alarm_update(a, &e, 20.0 + 0.1 * k, &s);
+    hm_alarm_update(a, &e, NULL, 20.0 + 0.1 * k, &s);
     changes += s.changed;
   }
   HM_CHECK(changes == 0, "%d level changes while dithering inside the hysteresis", changes);
@@ -135,24 +141,97 @@ static void bad_configuration_and_input(void) {
   c.warn_amplitude_fraction = 1.5;
   HM_CHECK(hm_alarm_config_validate(&c, why, sizeof why) == HM_EDOMAIN && strstr(why, "warn_amplitude_fraction"),
            "%s", why);
-  HM_CHECK(hm_alarm_create(&c, table) == NULL, "created with a bad configuration");
+  hm_alarm bad = (hm_alarm)0x1;
+  HM_CHECK(hm_alarm_create(&c, &vehicle, table, &bad, why, sizeof why) == HM_EDOMAIN && bad == (hm_alarm)0x1 &&
+               strstr(why, "warn_amplitude_fraction"),
+           "created with a bad configuration: %s", why);
   hm_alarm_config_default(&c);
   c.min_hold_s = NAN;
   HM_CHECK(hm_alarm_config_validate(&c, why, sizeof why) == HM_EDOMAIN && strstr(why, "min_hold_s"), "%s", why);
   hm_alarm a = make();
   hm_assessment s;
   const hm_estimate e = estimate(300.0, 0.0);
-  HM_CHECK(hm_alarm_update(a, &e, NAN, &s) == HM_EINVAL, "NaN time");
-  HM_CHECK(hm_alarm_update(a, NULL, 1.0, &s) == HM_EINVAL, "NULL estimate");
+  HM_CHECK(hm_alarm_update(a, &e, NULL, NAN, &s) == HM_EINVAL, "NaN time");
+  HM_CHECK(hm_alarm_update(a, NULL, NULL, 1.0, &s) == HM_EINVAL, "NULL estimate");
+  hm_alarm_destroy(a);
+}
+
+/* With a conicity estimate (0.16 +- 0.003, as margin.h makes them): the Hopf interval is the closed form's at the
+ * interval's conicities; inside it above the point estimate a small oscillation is WARN, not ALARM; above it ALARM;
+ * a large standard error falls back to the vehicle's conicity; a mismatch or a sensor at another rate is WATCH; a
+ * rate the filters cannot use is NO_DATA. */
+static void levels_with_a_conicity_estimate(void) {
+  hm_margin_estimate g;
+  memset(&g, 0, sizeof g);
+  g.conicity_valid = g.hopf_model_valid = 1;
+  g.conicity = 0.16;
+  g.conicity_se = 0.003;
+  g.conicity_low = 0.154;
+  g.conicity_high = 0.166;
+  g.hopf_model_kmh = hopf_closed_form(0.16);
+  g.hopf_model_low_kmh = hopf_closed_form(0.166);
+  g.hopf_model_high_kmh = hopf_closed_form(0.154);
+  const struct {
+    double v, amp;
+    hm_level level;
+    hm_reason reason;
+  } cases[] = {
+      {400.0, 0.0, HM_LEVEL_OK, HM_REASON_NORMAL},
+      {g.hopf_model_low_kmh - 20.0, 0.0, HM_LEVEL_WATCH, HM_REASON_APPROACHING_HOPF},
+      {g.hopf_model_low_kmh - 5.0, 0.0, HM_LEVEL_WARN, HM_REASON_NEAR_HOPF},
+      {g.hopf_model_kmh + 2.0, 0.0002, HM_LEVEL_WARN, HM_REASON_NEAR_HOPF},
+      {g.hopf_model_kmh + 2.0, 0.009, HM_LEVEL_ALARM, HM_REASON_AMPLITUDE_BEYOND_EDGE},
+      {g.hopf_model_high_kmh + 0.5, 0.0, HM_LEVEL_ALARM, HM_REASON_ABOVE_HOPF},
+  };
+  for (size_t i = 0; i < sizeof cases / sizeof cases[0]; ++i) {
+    hm_alarm a = make();
+    hm_assessment s;
+    const hm_estimate e = estimate(cases[i].v, cases[i].amp);
+    HM_CHECK(hm_alarm_update(a, &e, &g, 10.0, &s) == HM_OK, "update");
+    HM_CHECK(s.level == cases[i].level && s.reason == cases[i].reason, "case %zu: v %.1f amp %g: %s (%s)", i,
+             cases[i].v, cases[i].amp, hm_level_name(s.level), hm_reason_text(s.reason));
+    HM_CHECK(s.conicity_from_estimate && s.conicity == 0.16, "estimate in use");
+    HM_CHECK(s.hopf_low_kmh == g.hopf_model_low_kmh && s.hopf_high_kmh == g.hopf_model_high_kmh, "interval");
+    HM_CHECK_DELTA(s.boundaries.hopf_speed_kmh, g.hopf_model_kmh, 1e-6, "table Hopf vs closed form");
+    hm_alarm_destroy(a);
+  }
+  /* too uncertain: the fallback (the vehicle's lambda(0)) */
+  hm_margin_estimate wide = g;
+  wide.conicity_se = 0.05;
+  hm_alarm a = make();
+  hm_assessment s;
+  hm_estimate e = estimate(400.0, 0.0);
+  HM_CHECK(hm_alarm_update(a, &e, &wide, 0.0, &s) == HM_OK && !s.conicity_from_estimate && s.conicity == 0.1358,
+           "fallback %g", s.conicity);
+  hm_alarm_destroy(a);
+  hm_margin_estimate mismatch = g;
+  mismatch.model_mismatch = 1;
+  a = make();
+  HM_CHECK(hm_alarm_update(a, &e, &mismatch, 0.0, &s) == HM_OK && s.level == HM_LEVEL_WATCH &&
+               s.reason == HM_REASON_MODEL_MISMATCH,
+           "mismatch: %s", hm_reason_text(s.reason));
+  hm_alarm_destroy(a);
+  e.sample_rate_mismatch = 1;
+  a = make();
+  HM_CHECK(hm_alarm_update(a, &e, &g, 0.0, &s) == HM_OK && s.level == HM_LEVEL_WATCH &&
+               s.reason == HM_REASON_RATE_MISMATCH,
+           "rate: %s", hm_reason_text(s.reason));
+  e.sample_rate_supported = 0;
+  e.accel_valid = 0;
+  HM_CHECK(hm_alarm_update(a, &e, &g, 0.1, &s) == HM_OK && s.level == HM_LEVEL_NO_DATA &&
+               s.reason == HM_REASON_BAD_SAMPLE_RATE && !s.boundaries_valid,
+           "unusable rate: %s", hm_reason_text(s.reason));
   hm_alarm_destroy(a);
 }
 
 int main(void) {
+  hm_vehicle_default(&vehicle);
   if (hm_test_small_table(&table) != HM_OK) {
     printf("FAIL table_build\n");
     return 1;
   }
   HM_RUN(levels_follow_the_boundaries);
+  HM_RUN(levels_with_a_conicity_estimate);
   HM_RUN(stale_input_is_no_data);
   HM_RUN(hysteresis_and_hold_prevent_chatter);
   HM_RUN(bad_configuration_and_input);

@@ -1,0 +1,103 @@
+/*
+ * hunting_monitor - the distance to the linear critical (Hopf) speed, two ways, from identified hunting modes
+ * (issue #9; docs/MODEL.md sections 2 and 5).
+ *
+ * Input: windows of data at a steady speed, each with its identified hunting mode (modal.h). A window is used when
+ * its mode is valid, its speed varied by at most max_speed_spread_kmh, it is at min_speed_kmh or more, and it does
+ * not overlap the previous window used (so that the windows' errors are independent). Windows older than memory_s
+ * are forgotten (the wheels wear, the track changes).
+ *
+ * (a) Model-based. Each window's (decay rate, frequency, speed) is inverted jointly for the equivalent conicity
+ *     (inversion.h). The errors passed to the inversion are the fit's statistical ones and a systematic part:
+ *     frequency_model_error (relative: how far the model's hunting frequency may be from the vehicle's) and
+ *     decay_rate_model_error (relative: the identification's bias, about 10% on both simulators, README). The
+ *     windows' conicities are averaged with inverse-variance weights; the statistical part of the error shrinks
+ *     with the number of windows, the systematic part does not. The Hopf speed and its interval are the closed-form
+ *     critical speeds (linear.h) at lambda and at lambda -+ interval_z standard errors.
+ * (b) Model-free. The decay rates measured at the speeds the train has run are regressed on 1/v (the model's
+ *     damping terms scale with 1/v, so the hunting root's real part is nearly affine in 1/v: on the default vehicle
+ *     the zero of the line through 420 and 460 km/h is 519 km/h, the true Hopf 517.6; through 460 and 500, 517.9)
+ *     by weighted least squares; the Hopf speed is where the line reaches zero, with a delta-method interval. Valid
+ *     with two or more windows spanning min_speed_span_kmh, a slope significantly negative, and the zero no more
+ *     than max_extrapolation_kmh above the highest speed seen. A proportional bias of the decay rates does not move
+ *     this zero.
+ * When both are valid and their intervals do not overlap, the vehicle is not behaving like its model: model_mismatch.
+ */
+#ifndef HUNTING_MONITOR_MARGIN_H
+#define HUNTING_MONITOR_MARGIN_H
+
+#include <stddef.h>
+
+#include "hunting_monitor/inversion.h"
+#include "hunting_monitor/modal.h"
+#include "hunting_monitor/model.h"
+#include "hunting_monitor/status.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+#define HM_MARGIN_MAX_WINDOWS 64
+
+typedef struct {
+  double frequency_model_error;  /* relative error of the model's hunting frequency */
+  double decay_rate_model_error; /* relative bias allowed for the identified decay rate */
+  double max_speed_spread_kmh;   /* a window whose speed varied more is not used */
+  double min_speed_kmh;          /* windows below this speed are not used */
+  double memory_s;               /* windows older than this are forgotten */
+  double min_speed_span_kmh;     /* the model-free estimate needs windows this far apart in speed */
+  double max_extrapolation_kmh;  /* ... and a zero at most this far above the highest speed seen */
+  double interval_z;             /* intervals are +- this many standard errors */
+} hm_margin_config;
+
+/* Defaults: 1%, 10%, 10 km/h, 200 km/h, 900 s, 20 km/h, 150 km/h, z = 2 (about 95%). */
+void hm_margin_config_default(hm_margin_config *cfg);
+hm_status hm_margin_config_validate(const hm_margin_config *cfg, char *why, size_t why_len);
+
+typedef struct {
+  unsigned n_windows;               /* windows in memory */
+  int conicity_valid;               /* (a) */
+  double conicity, conicity_se;
+  double conicity_low, conicity_high; /* conicity -+ interval_z standard errors (low: Hopf at hopf_model_high) */
+  int hopf_model_valid;
+  double hopf_model_kmh, hopf_model_low_kmh, hopf_model_high_kmh;
+  int hopf_free_valid;              /* (b) */
+  double hopf_free_kmh, hopf_free_low_kmh, hopf_free_high_kmh;
+  double speed_min_kmh, speed_max_kmh; /* speeds of the windows in memory */
+  int model_mismatch;               /* (a) and (b) valid with disjoint intervals */
+} hm_margin_estimate;
+
+typedef enum {
+  HM_WINDOW_USED = 0,
+  HM_WINDOW_MODE_INVALID = 1,
+  HM_WINDOW_SPEED_VARIED = 2,
+  HM_WINDOW_TOO_SLOW = 3,
+  HM_WINDOW_OVERLAPS = 4,
+  HM_WINDOW_NO_INVERSION = 5
+} hm_window_verdict;
+
+typedef struct hm_margin_s *hm_margin;
+
+/* For a vehicle (its linear model is inverted). HM_EDOMAIN (reason in why) for a bad configuration or vehicle. */
+hm_status hm_margin_create(const hm_margin_config *cfg, const hm_vehicle *veh, hm_margin *out, char *why,
+                           size_t why_len);
+void hm_margin_destroy(hm_margin m);
+void hm_margin_reset(hm_margin m);
+
+/* Offer a window ending at t_end_s [s] with its mean speed and speed range [km/h]; the verdict says whether it was
+ * used. HM_EINVAL for NULL or non-finite arguments. */
+hm_status hm_margin_add_window(hm_margin m, double t_end_s, double speed_kmh, double speed_spread_kmh,
+                               const hm_mode_estimate *mode, hm_window_verdict *verdict);
+
+/* The estimate as of now_s (windows older than memory_s left out). */
+void hm_margin_read(const hm_margin m, double now_s, hm_margin_estimate *out);
+
+/* The closed-form Hopf speed [km/h] of the vehicle at a conicity; HM_TABLE_MAX_SPEED_KMH-like large value (1e4)
+ * when the linear model is stable at every speed there. */
+double hm_margin_hopf_kmh(const hm_margin m, double conicity);
+
+#ifdef __cplusplus
+}
+#endif
+
+#endif

@@ -1,0 +1,91 @@
+/*
+ * hunting_monitor - online identification of the hunting mode (frequency, decay rate, damping ratio) from the
+ * ambient response of the lateral acceleration to the track (issue #9; docs/MODEL.md sections 2 and 5).
+ *
+ * Method: a parametric fit of the spectrum of the last window_s of acceleration, by Whittle's likelihood.
+ *  - The signal is high-passed (2nd-order Butterworth at 2 Hz: drift and curving), low-passed (4th-order at 0.3 of
+ *    the decimated rate: anti-aliasing) and decimated to about decimated_rate_hz; the window's periodogram
+ *    I_k (rectangular window, zero-padded to a power of two) is taken over [band_low_hz, band_high_hz].
+ *  - The spectral model is one lightly damped mode over a smooth background plus white sensor noise:
+ *        S(w) = exp(c0 + c1 u + c2 u^2) / |(iw - s)(iw - conj s)|^2 + N,   s = sigma + i w0,  u = ln(w / w_ref).
+ *    The mode is the hunting pair of the linear model (its poles are s); the background exp(quadratic in ln w)
+ *    takes what is smooth across the band: the second, heavily damped pair of the same model (damping ratio about
+ *    0.6 at the same frequency), the s^2 of acceleration, the filters and the colour of the track excitation, which
+ *    differs between tracks and is not known.
+ *  - Whittle's log-likelihood  -sum(ln S_k + I_k / S_k)  is maximised by Fisher scoring with Levenberg damping
+ *    (J = d ln S / d theta, step (J'J + mu D)^-1 J'(I/S - 1)), warm-started from the previous fit; converged when
+ *    the objective changes by less than tol relative (failure: HM_ENOCONV after max_iter). The standard errors are
+ *    the square roots of the diagonal of (J'J)^-1, Whittle's asymptotic covariance.
+ *  - A stationary spectrum gives |sigma| but not its sign: the decay rate reported is -|sigma|. Growth (sigma > 0) is
+ *    seen by the amplitude tracker and the alarm, not here.
+ * Why not an AR model of the acceleration: the second mode at the same frequency and the double zero at DC of
+ * acceleration are not all-pole; on the exact spectrum of the default vehicle at 420 km/h, AR(10)/AR(20) fits of the
+ * decimated acceleration give a decay rate of -3.8 1/s where the model's eigenvalue is -6.33 (40% off), the peak fit
+ * -6.1..-6.8 depending on the excitation's colour. Bias and spread measured on both simulators: see README.
+ *
+ * Cost: per sample three biquads and a decimation counter; per fit (every fit_interval_s) one FFT of the window
+ * (4096 points at 100 Hz and 40 s) and about 5-20 scoring steps over the band's bins. No allocation after create.
+ */
+#ifndef HUNTING_MONITOR_MODAL_H
+#define HUNTING_MONITOR_MODAL_H
+
+#include <stddef.h>
+
+#include "hunting_monitor/status.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+typedef struct {
+  double window_s;          /* identification window [s] (longest data used) */
+  double min_window_s;      /* fits start once this much data is in [s] */
+  double decimated_rate_hz; /* target rate after decimation [Hz]; the band must lie below 0.4 of it */
+  double band_low_hz, band_high_hz; /* fitted band [Hz] (the hunting frequency must lie well inside) */
+  double fit_interval_s;    /* a new fit after this much new data [s] */
+  double tol;               /* relative change of the objective that ends the scoring */
+  unsigned max_iter;        /* scoring step limit */
+} hm_modal_config;
+
+/* Defaults: 40 s window (fits from 20 s), 100 Hz, band 6-22 Hz, a fit every second, tol 1e-10, 80 steps. */
+void hm_modal_config_default(hm_modal_config *cfg);
+/* HM_EDOMAIN with "field: reason" in why for an invalid configuration. */
+hm_status hm_modal_config_validate(const hm_modal_config *cfg, char *why, size_t why_len);
+
+typedef struct {
+  int valid;                   /* the fit converged with the mode inside the band */
+  double window_s;             /* data in the window [s] */
+  double frequency_hz, frequency_se_hz;        /* damped natural frequency w0 / 2 pi */
+  double decay_rate_1_s, decay_rate_se_1_s;    /* sigma = -|Re s| [1/s] (negative: decaying) */
+  double damping_ratio, damping_ratio_se;      /* -sigma / |s| */
+  double peak_to_mean;         /* the mode's spectral peak over the band's mean level (valid needs > 3) */
+  unsigned iterations;         /* scoring steps of this fit */
+} hm_mode_estimate;
+
+typedef struct hm_modal_s *hm_modal;
+
+/* Create for an input sample rate [Hz] (100..5000). HM_EDOMAIN (reason in why) for a bad configuration or a rate
+ * the configuration cannot be decimated from; HM_ENOMEM. *out untouched on failure. */
+hm_status hm_modal_create(const hm_modal_config *cfg, double sample_rate_hz, hm_modal *out, char *why,
+                          size_t why_len);
+void hm_modal_destroy(hm_modal m);
+/* Forget the window (after a gap); the next fit starts cold. */
+void hm_modal_reset(hm_modal m);
+/* A new input rate (the estimator measured one): resets. HM_EDOMAIN if it cannot be used (state unchanged). No
+ * allocation. */
+hm_status hm_modal_set_rate(hm_modal m, double sample_rate_hz);
+
+/* One acceleration sample [m/s^2] at the input rate (finite: the caller validates). */
+void hm_modal_push(hm_modal m, double accel_mps2);
+/* 1 when enough new data for a fit is in (fit_interval_s since the last one, min_window_s in all). */
+int hm_modal_fit_due(const hm_modal m);
+/* Fit the newest max_window_s of the window (at most window_s; the caller passes less when only the newest part was
+ * at a steady speed). HM_OK with out->valid set or cleared (mode outside the band, fewer than min_window_s of data);
+ * HM_ENOCONV if the scoring did not converge (out untouched); HM_EINVAL for max_window_s <= 0. */
+hm_status hm_modal_fit(hm_modal m, double max_window_s, hm_mode_estimate *out);
+
+#ifdef __cplusplus
+}
+#endif
+
+#endif

@@ -1,0 +1,81 @@
+/*
+ * hunting_monitor - the online monitor: one object that the ROS node, `hunting estimate` and the tests share.
+ *
+ * It owns the streaming estimator (estimator.h), the hunting-mode identification (modal.h), the margin
+ * (margin.h), the alarm (alarm.h) and the boundary table (tables.h), and holds the start-up policy:
+ *  - the table: a given one must have been made for this vehicle (hm_table_check_vehicle: stiffnesses and every
+ *    Hopf speed against the closed form); without one it is computed for the vehicle (table_n_conicity conicities);
+ *  - the conicity fallback: the alarm's conicity_fallback, or the vehicle's own lambda(0) when that is 0 (so a
+ *    fitted or worn vehicle never falls back to the default vehicle's conicity);
+ *  - the identification follows the estimator: restarted after a gap, redesigned for a measured sample rate.
+ * Windows of the identification are offered to the margin with the speed's mean and range over the window.
+ * No allocation after create.
+ */
+#ifndef HUNTING_MONITOR_MONITOR_H
+#define HUNTING_MONITOR_MONITOR_H
+
+#include <stddef.h>
+
+#include "hunting_monitor/alarm.h"
+#include "hunting_monitor/estimator.h"
+#include "hunting_monitor/margin.h"
+#include "hunting_monitor/modal.h"
+#include "hunting_monitor/model.h"
+#include "hunting_monitor/status.h"
+#include "hunting_monitor/tables.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+typedef struct {
+  hm_estimator_config estimator;
+  hm_modal_config modal;
+  hm_margin_config margin;
+  hm_alarm_config alarm;
+  size_t table_n_conicity; /* conicities of a table computed at start (when none is given) */
+} hm_monitor_config;
+
+/* Every part's defaults; 8 conicities for a computed table. */
+void hm_monitor_config_default(hm_monitor_config *cfg);
+/* The first invalid field as "section.field: reason". */
+hm_status hm_monitor_config_validate(const hm_monitor_config *cfg, char *why, size_t why_len);
+
+typedef struct {
+  hm_estimate estimate;        /* amplitude, frequency, criteria, inputs */
+  hm_mode_estimate mode;       /* the latest identification of the hunting mode (valid 0 before the first) */
+  double mode_speed_kmh;       /* mean speed over its window */
+  double mode_speed_spread_kmh;/* and its range */
+  hm_window_verdict mode_verdict; /* whether the margin used that window */
+  hm_margin_estimate margin;   /* conicity, Hopf speed model-based and model-free, mismatch */
+  hm_assessment assessment;    /* level, reason, boundaries and margins */
+} hm_monitor_status;
+
+typedef struct hm_monitor_s *hm_monitor;
+
+/*
+ * Create for a vehicle. table: one loaded from a file (the monitor takes it over, also on failure) or NULL to
+ * compute it (seconds). HM_EDOMAIN with the reason in why for a bad configuration, vehicle or table (a table for
+ * another vehicle), HM_ENOMEM, or the table computation's status. *out untouched on failure.
+ */
+hm_status hm_monitor_create(const hm_monitor_config *cfg, const hm_vehicle *veh, hm_table table, hm_monitor *out,
+                            char *why, size_t why_len);
+void hm_monitor_destroy(hm_monitor m);
+/* Forget the stream (time jumped): estimator, identification and alarm state; the margin's windows stay. */
+void hm_monitor_reset(hm_monitor m);
+
+/* One acceleration sample [m/s^2] at t_s; the estimator's status (rejected samples are counted there). */
+hm_status hm_monitor_push_accel(hm_monitor m, double t_s, double accel_mps2);
+/* One speed update [km/h]. */
+hm_status hm_monitor_push_speed(hm_monitor m, double t_s, double speed_kmh);
+/* Evaluate at now_s. HM_EINVAL for NULL or non-finite now; out untouched on failure. */
+hm_status hm_monitor_update(hm_monitor m, double now_s, hm_monitor_status *out);
+
+/* The table in use (borrowed), e.g. for reporting its range and errors. */
+hm_table hm_monitor_table(const hm_monitor m);
+
+#ifdef __cplusplus
+}
+#endif
+
+#endif

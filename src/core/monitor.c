@@ -1,0 +1,230 @@
+/* The online monitor: estimator + identification + margin + alarm + table, and the start-up policy (monitor.h). */
+#include "hunting_monitor/monitor.h"
+
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+/* Speed statistics per fit interval, so that the steady part of the window and its speed are known. */
+typedef struct {
+  double min, max, sum, n, duration_s;
+} speed_chunk;
+
+struct hm_monitor_s {
+  hm_monitor_config cfg;
+  hm_vehicle veh;
+  hm_table table;
+  hm_estimator est;
+  hm_modal modal;
+  hm_margin margin;
+  hm_alarm alarm;
+  int modal_ok;                  /* the identification can run at the current rate */
+  unsigned long restarts;        /* the estimator's, as last seen */
+  double rate_hz;
+  int have_speed;
+  double speed_kmh;
+  speed_chunk *chunks;           /* ring, one per fit interval */
+  size_t n_chunks_cap, chunk_head, n_chunks;
+  speed_chunk cur;
+  double t_chunk;                /* start of the current chunk */
+  double t_last;
+  hm_mode_estimate mode;
+  double mode_speed, mode_spread;
+  hm_window_verdict verdict;
+};
+
+void hm_monitor_config_default(hm_monitor_config *c) {
+  hm_estimator_config_default(&c->estimator);
+  hm_modal_config_default(&c->modal);
+  hm_margin_config_default(&c->margin);
+  hm_alarm_config_default(&c->alarm);
+  c->table_n_conicity = 8;
+}
+
+static hm_status prefixed(hm_status st, const char *section, char *why, size_t len) {
+  if (st != HM_OK && why && len) {
+    char tmp[256];
+    snprintf(tmp, sizeof tmp, "%s", why);
+    snprintf(why, len, "%s.%s", section, tmp);
+  }
+  return st;
+}
+
+hm_status hm_monitor_config_validate(const hm_monitor_config *c, char *why, size_t len) {
+  if (!c) return HM_EINVAL;
+  hm_status st = prefixed(hm_estimator_config_validate(&c->estimator, why, len), "estimator", why, len);
+  if (st == HM_OK) st = prefixed(hm_modal_config_validate(&c->modal, why, len), "modal", why, len);
+  if (st == HM_OK) st = prefixed(hm_margin_config_validate(&c->margin, why, len), "margin", why, len);
+  if (st == HM_OK) st = prefixed(hm_alarm_config_validate(&c->alarm, why, len), "alarm", why, len);
+  if (st == HM_OK && (c->table_n_conicity < 2 || c->table_n_conicity > 1000)) {
+    if (why && len) snprintf(why, len, "table_n_conicity: must be 2..1000 (got %zu)", c->table_n_conicity);
+    st = HM_EDOMAIN;
+  }
+  return st;
+}
+
+static void chunk_clear(speed_chunk *k) {
+  k->min = INFINITY;
+  k->max = -INFINITY;
+  k->sum = k->n = k->duration_s = 0.0;
+}
+
+static void restart_stream(hm_monitor m) {
+  m->n_chunks = m->chunk_head = 0;
+  chunk_clear(&m->cur);
+  m->t_chunk = NAN;
+}
+
+hm_status hm_monitor_create(const hm_monitor_config *cfg, const hm_vehicle *veh, hm_table table, hm_monitor *out,
+                            char *why, size_t len) {
+  hm_status st = !cfg || !veh || !out ? HM_EINVAL : hm_monitor_config_validate(cfg, why, len);
+  if (st == HM_OK) st = hm_vehicle_validate(veh, why, len);
+  if (st == HM_OK && table) st = hm_table_check_vehicle(table, veh, HM_TABLE_CHECK_TOL_KMH, why, len);
+  if (st == HM_OK && !table) {
+    hm_table_spec spec;
+    hm_table_spec_default(&spec);
+    spec.n_conicity = cfg->table_n_conicity;
+    st = hm_table_build(veh, &spec, &table);
+    if (st != HM_OK && why && len) snprintf(why, len, "computing the boundary tables: %s", hm_status_str(st));
+  }
+  hm_monitor m = st == HM_OK ? calloc(1, sizeof *m) : NULL;
+  if (st == HM_OK && !m) st = HM_ENOMEM;
+  if (st != HM_OK) {
+    hm_table_destroy(table);
+    return st;
+  }
+  m->cfg = *cfg;
+  m->veh = *veh;
+  m->table = table;
+  m->n_chunks_cap = (size_t)ceil(cfg->modal.window_s / cfg->modal.fit_interval_s) + 2;
+  m->chunks = malloc(m->n_chunks_cap * sizeof *m->chunks);
+  st = m->chunks ? HM_OK : HM_ENOMEM;
+  if (st == HM_OK) st = hm_estimator_create(&cfg->estimator, &m->est, why, len);
+  if (st == HM_OK) st = hm_modal_create(&cfg->modal, cfg->estimator.sample_rate_hz, &m->modal, why, len);
+  if (st == HM_OK) st = hm_margin_create(&cfg->margin, veh, &m->margin, why, len);
+  if (st == HM_OK) st = hm_alarm_create(&cfg->alarm, veh, table, &m->alarm, why, len);
+  if (st != HM_OK) {
+    hm_monitor_destroy(m);
+    return st;
+  }
+  m->modal_ok = 1;
+  m->restarts = hm_estimator_restarts(m->est, &m->rate_hz);
+  restart_stream(m);
+  *out = m;
+  return HM_OK;
+}
+
+void hm_monitor_destroy(hm_monitor m) {
+  if (!m) return;
+  hm_alarm_destroy(m->alarm);
+  hm_margin_destroy(m->margin);
+  hm_modal_destroy(m->modal);
+  hm_estimator_destroy(m->est);
+  hm_table_destroy(m->table);
+  free(m->chunks);
+  free(m);
+}
+
+void hm_monitor_reset(hm_monitor m) {
+  if (!m) return;
+  hm_estimator_reset(m->est);
+  m->modal_ok = hm_modal_set_rate(m->modal, m->cfg.estimator.sample_rate_hz) == HM_OK;
+  m->restarts = hm_estimator_restarts(m->est, &m->rate_hz);
+  m->have_speed = 0;
+  memset(&m->mode, 0, sizeof m->mode);
+  restart_stream(m);
+  hm_alarm_reset(m->alarm);
+}
+
+/* A fit of the identification over the steady part of the window (the newest stretch whose speed varied by at most
+ * the margin's max_speed_spread_kmh, up to window_s), offered to the margin when it is at least min_window_s long;
+ * the whole window (for display) otherwise. */
+static void fit(hm_monitor m, double t) {
+  m->cur.duration_s = isfinite(m->t_chunk) ? t - m->t_chunk : 0.0;
+  m->chunks[m->chunk_head] = m->cur;
+  m->chunk_head = (m->chunk_head + 1) % m->n_chunks_cap;
+  if (m->n_chunks < m->n_chunks_cap) ++m->n_chunks;
+  chunk_clear(&m->cur);
+  m->t_chunk = t;
+  speed_chunk steady;
+  chunk_clear(&steady);
+  for (size_t k = 0; k < m->n_chunks && steady.duration_s < m->cfg.modal.window_s; ++k) {
+    const speed_chunk *c = &m->chunks[(m->chunk_head + m->n_chunks_cap - 1 - k) % m->n_chunks_cap];
+    if (c->n == 0.0 || fmax(steady.max, c->max) - fmin(steady.min, c->min) > m->cfg.margin.max_speed_spread_kmh)
+      break;
+    steady.min = fmin(steady.min, c->min);
+    steady.max = fmax(steady.max, c->max);
+    steady.sum += c->sum;
+    steady.n += c->n;
+    steady.duration_s += c->duration_s;
+  }
+  const int is_steady = steady.duration_s >= m->cfg.modal.min_window_s;
+  hm_mode_estimate e;
+  if (hm_modal_fit(m->modal, is_steady ? steady.duration_s : m->cfg.modal.window_s, &e) != HM_OK) {
+    m->mode.valid = 0;
+    return;
+  }
+  m->mode = e;
+  m->mode_speed = steady.n > 0.0 ? steady.sum / steady.n : m->speed_kmh;
+  m->mode_spread = is_steady ? steady.max - steady.min : INFINITY;
+  m->verdict = HM_WINDOW_SPEED_VARIED;
+  if (is_steady) hm_margin_add_window(m->margin, t, m->mode_speed, m->mode_spread, &e, &m->verdict);
+}
+
+hm_status hm_monitor_push_accel(hm_monitor m, double t, double a) {
+  if (!m) return HM_EINVAL;
+  const hm_status st = hm_estimator_push_accel(m->est, t, a);
+  if (st != HM_OK) return st;
+  double rate;
+  const unsigned long restarts = hm_estimator_restarts(m->est, &rate);
+  if (restarts != m->restarts) { /* a gap or a redesign: the identification restarts with the filters */
+    m->restarts = restarts;
+    if (rate != m->rate_hz) {
+      m->rate_hz = rate;
+      m->modal_ok = hm_modal_set_rate(m->modal, rate) == HM_OK;
+    } else {
+      hm_modal_reset(m->modal);
+    }
+    restart_stream(m);
+  }
+  m->t_last = t;
+  if (m->have_speed) {
+    m->cur.min = fmin(m->cur.min, m->speed_kmh);
+    m->cur.max = fmax(m->cur.max, m->speed_kmh);
+    m->cur.sum += m->speed_kmh;
+    m->cur.n += 1.0;
+  }
+  if (!m->modal_ok) return HM_OK;
+  hm_modal_push(m->modal, a);
+  if (hm_modal_fit_due(m->modal)) fit(m, t);
+  return HM_OK;
+}
+
+hm_status hm_monitor_push_speed(hm_monitor m, double t, double v) {
+  if (!m) return HM_EINVAL;
+  const hm_status st = hm_estimator_push_speed(m->est, t, v);
+  if (st == HM_OK) {
+    m->have_speed = 1;
+    m->speed_kmh = v;
+  }
+  return st;
+}
+
+hm_status hm_monitor_update(hm_monitor m, double now, hm_monitor_status *out) {
+  if (!m || !out || !isfinite(now)) return HM_EINVAL;
+  hm_monitor_status s;
+  memset(&s, 0, sizeof s);
+  hm_estimator_read(m->est, now, &s.estimate);
+  hm_margin_read(m->margin, now, &s.margin);
+  const hm_status st = hm_alarm_update(m->alarm, &s.estimate, &s.margin, now, &s.assessment);
+  if (st != HM_OK) return st;
+  s.mode = m->mode;
+  s.mode_speed_kmh = m->mode_speed;
+  s.mode_speed_spread_kmh = isfinite(m->mode_spread) ? m->mode_spread : -1.0;
+  s.mode_verdict = m->verdict;
+  *out = s;
+  return HM_OK;
+}
+
+hm_table hm_monitor_table(const hm_monitor m) { return m ? m->table : NULL; }

@@ -1,0 +1,161 @@
+/* The conicity from the hunting mode (inversion.h) and the distance to the Hopf speed two ways (margin.h), against
+ * the eigenvalues of the model's Jacobian (dgeev, linear.h) and the closed-form critical speed. */
+#include <string.h>
+
+#include "hm_test.h"
+#include "hunting_monitor/inversion.h"
+#include "hunting_monitor/linear.h"
+#include "hunting_monitor/margin.h"
+
+static hm_vehicle vehicle;
+
+/* The least damped complex pair of the linear model's Jacobian (dgeev): the hunting mode. */
+static void hunting_eigenvalue(double conicity, double v_kmh, double *sigma, double *f_hz) {
+  double re[4], im[4];
+  hm_linear_eigenvalues(&vehicle, conicity, hm_mps_from_kmh(v_kmh), re, im);
+  *sigma = re[0];
+  *f_hz = fabs(im[0]) / (2.0 * HM_PI);
+}
+
+static double hopf_kmh(double conicity) {
+  double v;
+  hm_linear_critical_speed(&vehicle, conicity, &v);
+  return hm_kmh_from_mps(v);
+}
+
+/* The exact mode of (lambda, V) inverts to lambda (1e-7) over the service range; the sensitivities agree with finite
+ * differences of the eigenvalues; far below the Hopf speed the frequency carries weight, near it the decay rate. */
+static void inversion_recovers_the_conicity(void) {
+  hm_linear_coef coef;
+  hm_linear_coef_from_vehicle(&vehicle, &coef);
+  const double lambdas[] = {0.08, 0.12, 0.1358, 0.16, 0.25}, speeds[] = {300.0, 420.0, 480.0};
+  for (int i = 0; i < 5; ++i)
+    for (int j = 0; j < 3; ++j) {
+      double s, f;
+      hunting_eigenvalue(lambdas[i], speeds[j], &s, &f);
+      if (!(s < 0.0)) continue; /* above the Hopf speed there: no decaying mode to invert */
+      hm_conicity_inversion r;
+      HM_CHECK(hm_conicity_from_mode(&coef, speeds[j], s, 0.1, f, 0.01, 1e-12, 50, &r) == HM_OK, "lambda %g V %g",
+               lambdas[i], speeds[j]);
+      HM_CHECK_DELTA(r.conicity, lambdas[i], 1e-7, "conicity");
+      HM_CHECK(r.chi2 < 1e-8, "chi2 %g for an exact mode", r.chi2);
+      double s2, f2;
+      hunting_eigenvalue(lambdas[i] + 1e-6, speeds[j], &s2, &f2);
+      HM_CHECK_REL(r.dsigma_dconicity, (s2 - s) / 1e-6, 1e-3, "dsigma/dlambda");
+      HM_CHECK_DELTA(r.dfrequency_dconicity, (f2 - f) / 1e-6, 1e-3 * fabs(r.dsigma_dconicity) / (2 * HM_PI),
+                     "dfrequency/dlambda");
+    }
+  /* standard error: 1/sqrt(J'J) with J the sensitivities over the errors */
+  double s, f;
+  hunting_eigenvalue(0.16, 440.0, &s, &f);
+  hm_conicity_inversion r;
+  HM_CHECK(hm_conicity_from_mode(&coef, 440.0, s, 0.3, f, 0.05, 1e-12, 50, &r) == HM_OK, "invert");
+  const double j1 = r.dsigma_dconicity / 0.3, j2 = r.dfrequency_dconicity / 0.05;
+  HM_CHECK_REL(r.conicity_se, 1.0 / sqrt(j1 * j1 + j2 * j2), 1e-9, "standard error");
+  /* a measured frequency 3 errors off the model's explains as misfit, not as a conicity 3 errors off */
+  hm_conicity_inversion r2;
+  HM_CHECK(hm_conicity_from_mode(&coef, 440.0, s, 0.3, f + 0.15, 0.05, 1e-12, 50, &r2) == HM_OK, "invert");
+  HM_CHECK(r2.chi2 > 1.0 && fabs(r2.conicity - 0.16) < 3.0 * r.conicity_se, "chi2 %g, conicity %g", r2.chi2,
+           r2.conicity);
+  hm_conicity_inversion untouched;
+  memset(&untouched, 0x5a, sizeof untouched);
+  const hm_conicity_inversion before = untouched;
+  HM_CHECK(hm_conicity_from_mode(&coef, 440.0, 0.5, 0.3, f, 0.05, 1e-12, 50, &untouched) == HM_EDOMAIN,
+           "growing mode");
+  HM_CHECK(hm_conicity_from_mode(&coef, NAN, s, 0.3, f, 0.05, 1e-12, 50, &untouched) == HM_EDOMAIN, "NaN speed");
+  HM_CHECK(memcmp(&untouched, &before, sizeof before) == 0, "output changed on failure");
+}
+
+static hm_mode_estimate mode_at(double conicity, double v, double se_sigma, double se_f) {
+  hm_mode_estimate m;
+  memset(&m, 0, sizeof m);
+  hunting_eigenvalue(conicity, v, &m.decay_rate_1_s, &m.frequency_hz);
+  m.valid = 1;
+  m.window_s = 40.0;
+  m.decay_rate_se_1_s = se_sigma;
+  m.frequency_se_hz = se_f;
+  return m;
+}
+
+/* Worn wheels (lambda 0.16, Hopf 473.77 km/h by the closed form) at 420, 440 and 455 km/h with the errors the
+ * identification achieves (MODEL values for decay rate and frequency): the model-based Hopf speed is the closed
+ * form's, its interval covers it; the model-free one (decay rates against 1/v) is within 2 km/h of it and its
+ * interval covers it; no mismatch. */
+static void both_ways_agree_on_a_consistent_vehicle(void) {
+  hm_margin_config c;
+  hm_margin_config_default(&c);
+  hm_margin m = NULL;
+  HM_CHECK(hm_margin_create(&c, &vehicle, &m, NULL, 0) == HM_OK, "create");
+  if (!m) return;
+  const double speeds[] = {420.0, 440.0, 455.0}, truth = hopf_kmh(0.16);
+  for (int k = 0; k < 3; ++k) {
+    const hm_mode_estimate e = mode_at(0.16, speeds[k], 0.3, 0.05);
+    hm_window_verdict v;
+    HM_CHECK(hm_margin_add_window(m, 40.0 * (k + 1), speeds[k], 2.0, &e, &v) == HM_OK && v == HM_WINDOW_USED,
+             "window %d: verdict %d", k, v);
+  }
+  hm_margin_estimate g;
+  hm_margin_read(m, 120.0, &g);
+  printf("  model-based %.2f [%.2f, %.2f], model-free %.2f [%.2f, %.2f], closed form %.2f km/h\n", g.hopf_model_kmh,
+         g.hopf_model_low_kmh, g.hopf_model_high_kmh, g.hopf_free_kmh, g.hopf_free_low_kmh, g.hopf_free_high_kmh, truth);
+  HM_CHECK(g.n_windows == 3 && g.conicity_valid && g.hopf_model_valid && g.hopf_free_valid, "validity");
+  HM_CHECK_DELTA(g.conicity, 0.16, 1e-6, "conicity");
+  HM_CHECK_DELTA(g.hopf_model_kmh, truth, 1e-3, "model-based Hopf speed");
+  HM_CHECK(g.hopf_model_low_kmh < truth && truth < g.hopf_model_high_kmh, "model-based interval");
+  HM_CHECK_DELTA(g.hopf_model_low_kmh, hopf_kmh(g.conicity + 2.0 * g.conicity_se), 1e-6, "interval from closed form");
+  HM_CHECK_DELTA(g.hopf_free_kmh, truth, 2.0, "model-free Hopf speed");
+  HM_CHECK(g.hopf_free_low_kmh < truth && truth < g.hopf_free_high_kmh, "model-free interval");
+  HM_CHECK(!g.model_mismatch, "mismatch on a consistent vehicle");
+  /* forgotten after memory_s */
+  hm_margin_read(m, 120.0 + c.memory_s + 41.0, &g);
+  HM_CHECK(g.n_windows == 2 && g.hopf_free_valid == 0, "memory: %u windows", g.n_windows);
+  hm_margin_destroy(m);
+}
+
+/* Windows that cannot be used are refused with their reason; a vehicle whose decay rates say one Hopf speed and
+ * whose frequencies (trusted here: no model error) say another is flagged. */
+static void refusals_and_mismatch(void) {
+  hm_margin_config c;
+  hm_margin_config_default(&c);
+  hm_margin m = NULL;
+  hm_margin_create(&c, &vehicle, &m, NULL, 0);
+  hm_mode_estimate e = mode_at(0.16, 420.0, 0.3, 0.05);
+  hm_window_verdict v;
+  hm_margin_add_window(m, 40.0, 420.0, 25.0, &e, &v);
+  HM_CHECK(v == HM_WINDOW_SPEED_VARIED, "spread: %d", v);
+  hm_margin_add_window(m, 40.0, 150.0, 1.0, &e, &v);
+  HM_CHECK(v == HM_WINDOW_TOO_SLOW, "slow: %d", v);
+  e.valid = 0;
+  hm_margin_add_window(m, 40.0, 420.0, 1.0, &e, &v);
+  HM_CHECK(v == HM_WINDOW_MODE_INVALID, "invalid: %d", v);
+  e.valid = 1;
+  hm_margin_add_window(m, 40.0, 420.0, 1.0, &e, &v);
+  HM_CHECK(v == HM_WINDOW_USED, "used: %d", v);
+  hm_margin_add_window(m, 60.0, 420.0, 1.0, &e, &v);
+  HM_CHECK(v == HM_WINDOW_OVERLAPS, "overlap: %d", v);
+  HM_CHECK(hm_margin_add_window(m, NAN, 420.0, 1.0, &e, &v) == HM_EINVAL, "NaN time");
+  hm_margin_destroy(m);
+
+  c.frequency_model_error = 0.0;
+  hm_margin_create(&c, &vehicle, &m, NULL, 0);
+  const double speeds[] = {420.0, 440.0, 455.0};
+  for (int k = 0; k < 3; ++k) {
+    hm_mode_estimate d = mode_at(0.16, speeds[k], 0.3, 0.005), f = mode_at(0.12, speeds[k], 0.3, 0.005);
+    d.frequency_hz = f.frequency_hz; /* decay rates of lambda 0.16, frequencies of lambda 0.12 */
+    hm_margin_add_window(m, 40.0 * (k + 1), speeds[k], 2.0, &d, &v);
+  }
+  hm_margin_estimate g;
+  hm_margin_read(m, 120.0, &g);
+  printf("  inconsistent: model-based %.1f [%.1f, %.1f], model-free %.1f [%.1f, %.1f]\n", g.hopf_model_kmh,
+         g.hopf_model_low_kmh, g.hopf_model_high_kmh, g.hopf_free_kmh, g.hopf_free_low_kmh, g.hopf_free_high_kmh);
+  HM_CHECK(g.model_mismatch, "no mismatch flagged");
+  hm_margin_destroy(m);
+}
+
+int main(void) {
+  hm_vehicle_default(&vehicle);
+  HM_RUN(inversion_recovers_the_conicity);
+  HM_RUN(both_ways_agree_on_a_consistent_vehicle);
+  HM_RUN(refusals_and_mismatch);
+  HM_TEST_EXIT();
+}
