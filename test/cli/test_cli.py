@@ -459,6 +459,114 @@ def test_unbounded_work_is_refused():
         assert p.returncode == 1 and message in p.stderr, (args, p.stderr)
 
 
+# ---- the monitor on recordings of a second, independent simulator (../shared/scenarios/independent_sim.py: its own
+# RK4 integrator at the sensor rate, its own track spectrum entering the wheel-rail terms, a 1 kHz accelerometer with
+# 0.2 m/s^2 noise, a noisy 100 Hz speed signal). Recordings are cached in $HM_SIM_CACHE (scripts/test sets it) so the
+# sanitizer run reuses them.
+
+def independent_sim():
+    path = os.environ.get("HM_INDEPENDENT_SIM") or os.path.join(SRC, "..", "shared", "scenarios", "independent_sim.py")
+    if not os.path.exists(path):
+        raise AssertionError(f"the independent simulator is not at {path} (set HM_INDEPENDENT_SIM)")
+    return path
+
+
+def recording(name, *args):
+    """(accel, speed, truth) of an independent-simulator run, made once."""
+    cache = os.environ.get("HM_SIM_CACHE") or os.path.join(tempfile.gettempdir(), "hm_sim_cache")
+    os.makedirs(cache, exist_ok=True)
+    truth = os.path.join(cache, name + "_truth.json")
+    if not os.path.exists(truth):
+        subprocess.run(["/usr/bin/python3", independent_sim(), *args, "--out", cache, "--name", name],
+                       check=True, capture_output=True, timeout=600)
+    with open(truth) as f:
+        return os.path.join(cache, name + "_accel.csv"), os.path.join(cache, name + "_speed.csv"), json.load(f)
+
+
+def shipped_table():
+    return os.path.join(SRC, "config", "crh380_default.tbl")
+
+
+def estimate_lines(acc, spd, every, *extra):
+    return lines(run("estimate", "--accel", acc, "--speed", spd, "--table", shipped_table(), "--every", str(every),
+                     *extra).stdout)
+
+
+def model_decay_rate(v_kmh, conicity):
+    """Real part of the least damped pair of the linear model (dgeev): the reference."""
+    return run_json("eig", "--v", str(v_kmh), "--conicity", str(conicity))["eigenvalues"][0][0]
+
+
+def test_independent_sim_decay_rates():
+    # 45 s at a steady speed (the first 5 s of the simulator's start-up included), five seeds each: the decay rate
+    # the monitor identifies is within max(25%, 0.3 1/s) of the model's eigenvalue
+    report = []
+    for v in (420, 460, 500):
+        truth = model_decay_rate(v, 0.1358)
+        got = []
+        for seed in range(1, 6):
+            acc, spd, _ = recording(f"const{v}_s{seed}", "--profile", f"const:{v}", "--t", "45", "--seed", str(seed))
+            last = estimate_lines(acc, spd, 45)[-1]
+            assert last["mode_valid"], (v, seed, last)
+            got.append(last["decay_rate_1_s"])
+            close(last["decay_rate_1_s"], truth, max(0.25 * abs(truth), 0.3), f"decay rate at {v} km/h seed {seed}")
+            assert last["level"] != "ALARM", (v, seed, last["reason"])
+        report.append(f"{v} km/h: {min(got):.2f}..{max(got):.2f} (model {truth:.2f})")
+    print("  independent simulator, decay rates: " + "; ".join(report))
+
+
+def test_independent_sim_worn_and_new_wheels():
+    # 120 s at three steady speeds below the Hopf speed: the Hopf speed shown within 10 km/h of the truth (the
+    # closed form at the true conicity) with an interval covering it; never ALARM on these stable vehicles
+    cases = [("worn", 0.16, "steps:420@40,440@40,455@40", 1), ("worn", 0.16, "steps:420@40,440@40,455@40", 2),
+             ("new", 0.12, "steps:480@40,500@40,520@40", 11), ("new", 0.12, "steps:480@40,500@40,520@40", 12)]
+    report = []
+    for kind, conicity, profile, seed in cases:
+        acc, spd, truth = recording(f"{kind}_s{seed}", "--profile", profile, "--lambda0", str(conicity), "--t", "120",
+                                    "--seed", str(seed))
+        assert truth["t_hunt_3mm"] is None, truth
+        hopf = run_json("critical", "--conicity", str(conicity))["v_crit_kmh"]
+        out = estimate_lines(acc, spd, 1)
+        last = out[-1]
+        assert last["conicity_from_estimate"] and last["windows_used"] >= 2, last
+        close(last["hopf_kmh"], hopf, 10.0, f"{kind} seed {seed}: Hopf speed shown")
+        assert last["hopf_kmh_low"] <= hopf <= last["hopf_kmh_high"], (hopf, last["hopf_kmh_low"], last["hopf_kmh_high"])
+        assert not any(o["level"] == "ALARM" for o in out), [(o["t_s"], o["reason"]) for o in out if o["level"] == "ALARM"]
+        report.append(f"{kind} {seed}: {last['hopf_kmh']:.1f} [{last['hopf_kmh_low']:.1f}, {last['hopf_kmh_high']:.1f}]"
+                      f" (true {hopf:.1f})")
+    print("  independent simulator, Hopf speeds: " + "; ".join(report))
+
+
+def test_independent_sim_ramp_through_hopf():
+    # 505 -> 535 km/h at 0.5 km/h/s: no ALARM below 515 km/h unless the wheelset is already hunting (the track can
+    # kick it over the unstable cycle inside the bistable band: then no ALARM earlier than 1 s before it passes 3 mm);
+    # ALARM no later than 1 s after it passes 3 mm
+    for seed in (21, 22, 23):
+        acc, spd, truth = recording(f"ramp_s{seed}", "--profile", "ramp:505:0.5", "--t", "60", "--seed", str(seed))
+        t3 = truth["t_hunt_3mm"]
+        assert t3 is not None, truth
+        out = estimate_lines(acc, spd, 0.05)
+        first = next(o for o in out if o["level"] == "ALARM")
+        assert first["t_s"] <= t3 + 1.0, (seed, first["t_s"], t3)
+        assert first["speed_kmh"] >= 515.0 or first["t_s"] >= t3 - 1.0, (seed, first["speed_kmh"], first["t_s"], t3)
+
+
+def test_independent_sim_sample_rates():
+    # one run recorded at 500 Hz, 1 kHz and 2 kHz, read with the shipped settings (2 kHz expected): the same amplitude
+    # (within 10%) and frequency (within 1%), the other rates reported as mismatches
+    mon = os.path.join(SRC, "config", "monitor.yaml")
+    got = {}
+    for fs in (500, 1000, 2000):
+        acc, spd, _ = recording(f"rate{fs}", "--profile", "const:505", "--t", "20", "--seed", "31", "--fs", str(fs))
+        last = estimate_lines(acc, spd, 20, "--monitor", mon)[-1]
+        assert last["sample_rate_mismatch"] == (fs != 2000), (fs, last["sample_rate_hz"])
+        close(last["sample_rate_hz"], fs, 0.01 * fs, "measured rate")
+        got[fs] = last
+    for fs in (500, 1000):
+        close(got[fs]["amplitude_m"], got[2000]["amplitude_m"], 0.1 * got[2000]["amplitude_m"], f"amplitude at {fs} Hz")
+        close(got[fs]["frequency_hz"], got[2000]["frequency_hz"], 0.01 * got[2000]["frequency_hz"], f"frequency at {fs} Hz")
+
+
 def main():
     global failures
     tests = [(n, f) for n, f in globals().items() if n.startswith("test_") and callable(f)]
