@@ -68,6 +68,11 @@ bool MonitorRos::loadParameters() {
   pnh_.param<std::string>("frame_id", frame_id_, "base_link");
   pnh_.param<std::string>("table_file", table_file_, "");
   pnh_.param("status_rate_hz", status_rate_hz_, 20.0);
+  pnh_.param("max_clock_offset_s", max_clock_offset_s_, 1.0);
+  if (!(max_clock_offset_s_ > 0.0 && max_clock_offset_s_ <= 3600.0)) {
+    ROS_FATAL("hunting_monitor: ~max_clock_offset_s must be in (0, 3600], got %g", max_clock_offset_s_);
+    return false;
+  }
   if (accel_type_ != "imu" && accel_type_ != "float64") {
     ROS_FATAL("hunting_monitor: ~accel_type must be imu or float64, got '%s'", accel_type_.c_str());
     return false;
@@ -109,26 +114,73 @@ bool MonitorRos::loadParameters() {
   return true;
 }
 
+void MonitorRos::timeJumped(const std::string& what) {
+  hm_monitor_reset(monitor_);
+  ++time_jumps_;
+  last_jump_ = what;
+  last_jump_at_ = ros::WallTime::now().toSec();
+  ROS_WARN("hunting_monitor: %s: monitor reset, monitoring again after its settling time", what.c_str());
+}
+
+void MonitorRos::checkRosTime(const ros::Time& now) {
+  const double t = now.toSec();
+  if (last_ros_time_ > 0.0 && t < last_ros_time_ - 0.5) {
+    char what[160];
+    std::snprintf(what, sizeof what, "ROS time moved backwards by %.3f s (a bag restarted or looped)",
+                  last_ros_time_ - t);
+    stamp_offset_s_ = 0.0;
+    offset_since_ = -1.0;
+    timeJumped(what);
+  }
+  last_ros_time_ = t;
+}
+
+double MonitorRos::sensorTime(double stamp, double now) {
+  const double t = stamp - stamp_offset_s_;
+  if (std::fabs(t - now) <= max_clock_offset_s_) {
+    offset_since_ = -1.0;
+    return t;
+  }
+  ++dropped_offset_;
+  if (offset_since_ < 0.0) offset_since_ = now;
+  if (now - offset_since_ < 1.0) return NAN;  // a glitch, or a jump still to be confirmed
+  char what[160];
+  std::snprintf(what, sizeof what, "sensor stamps %.3f s from ROS time for 1 s (its clock jumped): re-anchored",
+                t - now);
+  stamp_offset_s_ = stamp - now;
+  offset_since_ = -1.0;
+  timeJumped(what);
+  return stamp - stamp_offset_s_;
+}
+
 void MonitorRos::pushAccel(double t, double a) {
   if (hm_monitor_push_accel(monitor_, t, a) == HM_OK) accel_freq_->tick();
 }
 
 void MonitorRos::onAccelFloat(const std_msgs::Float64::ConstPtr& msg) {
-  pushAccel(ros::Time::now().toSec(), msg->data);  // receipt time: no stamp in a Float64
+  const ros::Time now = ros::Time::now();
+  checkRosTime(now);
+  pushAccel(now.toSec(), msg->data);  // receipt time: no stamp in a Float64
 }
 
 void MonitorRos::onAccelImu(const sensor_msgs::Imu::ConstPtr& msg) {
+  const ros::Time now = ros::Time::now();
+  checkRosTime(now);
+  const double t = sensorTime(msg->header.stamp.toSec(), now.toSec());
   const auto& a = msg->linear_acceleration;
-  pushAccel(msg->header.stamp.toSec(), imu_axis_ == "x" ? a.x : imu_axis_ == "y" ? a.y : a.z);
+  if (std::isfinite(t)) pushAccel(t, imu_axis_ == "x" ? a.x : imu_axis_ == "y" ? a.y : a.z);
 }
 
 void MonitorRos::onSpeed(const std_msgs::Float64::ConstPtr& msg) {
   const double v = speed_unit_ == "mps" ? msg->data * 3.6 : msg->data;
-  hm_monitor_push_speed(monitor_, ros::Time::now().toSec(), v);
+  const ros::Time now = ros::Time::now();
+  checkRosTime(now);
+  hm_monitor_push_speed(monitor_, now.toSec(), v);
 }
 
 void MonitorRos::onTimer(const ros::TimerEvent&) {
   const ros::Time now = ros::Time::now();
+  checkRosTime(now);
   hm_monitor_status st;
   if (hm_monitor_update(monitor_, now.toSec(), &st) != HM_OK) return;
   last_ = st;
@@ -257,6 +309,8 @@ void MonitorRos::diagnoseInputs(diagnostic_updater::DiagnosticStatusWrapper& sta
                  : !e.sample_rate_supported ? "acceleration at a sample rate the filters cannot use"
                  : !e.accel_valid           ? "acceleration stale or missing"
                                             : "speed stale or missing");
+  else if (ros::WallTime::now().toSec() - last_jump_at_ < 10.0)
+    stat.summary(diagnostic_msgs::DiagnosticStatus::WARN, "time jumped: " + last_jump_);
   else if (e.sample_rate_mismatch)
     stat.summary(diagnostic_msgs::DiagnosticStatus::WARN,
                  "acceleration at " + std::to_string(static_cast<int>(std::lround(e.sample_rate_measured_hz))) +
@@ -275,6 +329,9 @@ void MonitorRos::diagnoseInputs(diagnostic_updater::DiagnosticStatusWrapper& sta
   stat.add("rejected out of order", e.n_rejected_order);
   stat.add("gaps", e.n_gaps);
   stat.add("rejected speeds", e.n_speed_rejected);
+  stat.add("time jumps", time_jumps_);
+  stat.add("last time jump", last_jump_.empty() ? std::string("none") : last_jump_);
+  stat.add("samples dropped for clock offset", dropped_offset_);
   stat.add("oscillation valid", static_cast<bool>(e.oscillation_valid));
 }
 

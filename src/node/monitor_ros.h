@@ -32,6 +32,12 @@ class MonitorRos {
   void onAccelImu(const sensor_msgs::Imu::ConstPtr& msg);
   void onSpeed(const std_msgs::Float64::ConstPtr& msg);
   void pushAccel(double t, double a);
+  // Time that jumps: ROS time moving backwards (a bag restarted or looped) or a sensor's stamps far from ROS time
+  // (its clock jumped) restarts the monitor on the new time line; returns the time to use for a stamp (or NaN to
+  // drop the sample while a lasting offset is being confirmed).
+  void checkRosTime(const ros::Time& now);
+  double sensorTime(double stamp, double now);
+  void timeJumped(const std::string& what);
   void onTimer(const ros::TimerEvent& ev);
   void publishMarkers(const hm_monitor_status& st, const ros::Time& now);
   void diagnoseInputs(diagnostic_updater::DiagnosticStatusWrapper& stat);
@@ -50,6 +56,14 @@ class MonitorRos {
   hm_monitor_status last_{};
   bool have_last_ = false;
   int last_published_level_ = -1;
+  // time jumps
+  double max_clock_offset_s_ = 1.0;
+  double last_ros_time_ = 0.0;
+  double stamp_offset_s_ = 0.0;      // subtracted from sensor stamps after a re-anchoring
+  double offset_since_ = -1.0;       // ROS time since which stamps are off (negative: they are not)
+  unsigned long time_jumps_ = 0, dropped_offset_ = 0;
+  std::string last_jump_;
+  double last_jump_at_ = -1e300;
   // ROS
   ros::Subscriber accel_sub_, speed_sub_;
   ros::Publisher status_pub_, alarm_pub_, marker_pub_;

@@ -1,0 +1,26 @@
+/* libFuzzer harness: the vehicle YAML parser, and the writer's promise that parsing its output gives back the same
+ * doubles. */
+#include <stdint.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "hunting_monitor/config.h"
+
+int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size) {
+  hm_vehicle v, back;
+  char name[HM_VEHICLE_NAME_MAX], err[256];
+  if (hm_config_parse_vehicle((const char *)data, size, "fuzz", &v, name, err, sizeof err) != HM_OK) return 0;
+  if (hm_vehicle_validate(&v, NULL, 0) != HM_OK) __builtin_trap(); /* parsed means valid */
+  size_t need = 0;
+  hm_config_format_vehicle(&v, name, "fuzz", NULL, 0, &need);
+  char *text = malloc(need);
+  if (!text) return 0;
+  if (hm_config_format_vehicle(&v, name, "fuzz", text, need, &need) != HM_OK) __builtin_trap();
+  if (hm_config_parse_vehicle(text, need - 1, "round trip", &back, name, err, sizeof err) != HM_OK) __builtin_trap();
+  if (back.mass_kg != v.mass_kg || back.stiffness_long_n_m != v.stiffness_long_n_m ||
+      back.stiffness_lat_n_m != v.stiffness_lat_n_m || back.conicity.n_terms != v.conicity.n_terms ||
+      back.conicity.constant != v.conicity.constant || back.flange_alpha2_n_m5 != v.flange_alpha2_n_m5)
+    __builtin_trap();
+  free(text);
+  return 0;
+}
