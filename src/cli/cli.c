@@ -252,71 +252,97 @@ static int parse_any_double(const char *s, double *out) {
   return 0;
 }
 
-int cli_read_csv(const char *path, int ncols, char header[][64], double **data, size_t *n,
-                 int allow_nonfinite) {
-  FILE *f = fopen(path, "r");
-  if (!f) {
-    fprintf(stderr, "hunting: %s: cannot open: %s\n", path, strerror(errno));
-    return 1;
-  }
-  char line[1024];
-  size_t lineno = 0, rows = 0, cap = 0;
-  double *d = NULL;
-  int have_header = 0, rc = 0;
-  while (rc == 0 && fgets(line, sizeof line, f)) {
-    ++lineno;
-    if (!strchr(line, '\n') && !feof(f)) {
-      fprintf(stderr, "hunting: %s:%zu: line too long\n", path, lineno);
-      rc = 1;
-      break;
+/* The next non-blank, non-comment line split into exactly ncols fields: 1, 0 at the end, -1 on an error. */
+static int csv_fields(cli_csv *c, char *line, size_t cap, char **fields) {
+  while (fgets(line, (int)cap, c->f)) {
+    ++c->lineno;
+    if (!strchr(line, '\n') && !feof(c->f)) {
+      fprintf(stderr, "hunting: %s:%zu: line too long\n", c->path, c->lineno);
+      return -1;
     }
     char *t = trim(line);
     if (!*t || *t == '#') continue;
-    char *fields[16];
     const int k = split_commas(t, fields, 16);
-    if (k != ncols) {
-      fprintf(stderr, "hunting: %s:%zu: expected %d comma-separated columns, found %d\n", path, lineno, ncols, k);
-      rc = 1;
-      break;
+    if (k != c->ncols) {
+      fprintf(stderr, "hunting: %s:%zu: expected %d comma-separated columns, found %d\n", c->path, c->lineno,
+              c->ncols, k);
+      return -1;
     }
-    if (!have_header) {
-      for (int c = 0; c < ncols; ++c) snprintf(header[c], 64, "%s", fields[c]);
-      have_header = 1;
-      continue;
+    return 1;
+  }
+  if (ferror(c->f)) {
+    fprintf(stderr, "hunting: %s: read error\n", c->path);
+    return -1;
+  }
+  return 0;
+}
+
+int cli_csv_open(cli_csv *c, const char *path, int ncols, int allow_nonfinite) {
+  memset(c, 0, sizeof *c);
+  c->path = path;
+  c->ncols = ncols;
+  c->allow_nonfinite = allow_nonfinite;
+  if (ncols < 1 || ncols > 16) return 1;
+  c->f = fopen(path, "r");
+  if (!c->f) {
+    fprintf(stderr, "hunting: %s: cannot open: %s\n", path, strerror(errno));
+    return 1;
+  }
+  char line[1024], *fields[16];
+  const int r = csv_fields(c, line, sizeof line, fields);
+  if (r == 0) fprintf(stderr, "hunting: %s: no header line\n", path);
+  if (r != 1) {
+    cli_csv_close(c);
+    return 1;
+  }
+  for (int k = 0; k < ncols; ++k) snprintf(c->header[k], 64, "%s", fields[k]);
+  return 0;
+}
+
+int cli_csv_next(cli_csv *c, double *row) {
+  char line[1024], *fields[16];
+  const int r = csv_fields(c, line, sizeof line, fields);
+  if (r != 1) return r;
+  for (int k = 0; k < c->ncols; ++k)
+    if (c->allow_nonfinite ? parse_any_double(fields[k], &row[k]) : parse_double(fields[k], &row[k])) {
+      fprintf(stderr, "hunting: %s:%zu: column '%s': expected a %snumber, got '%s'\n", c->path, c->lineno,
+              c->header[k], c->allow_nonfinite ? "" : "finite ", fields[k]);
+      return -1;
     }
+  return 1;
+}
+
+void cli_csv_close(cli_csv *c) {
+  if (c->f) fclose(c->f);
+  c->f = NULL;
+}
+
+int cli_read_csv(const char *path, int ncols, char header[][64], double **data, size_t *n, int allow_nonfinite) {
+  cli_csv c;
+  if (cli_csv_open(&c, path, ncols, allow_nonfinite)) return 1;
+  size_t rows = 0, cap = 0;
+  double *d = NULL;
+  int r;
+  for (;;) {
     if (rows == cap) {
       cap = cap ? 2 * cap : 256;
       double *bigger = realloc(d, cap * (size_t)ncols * sizeof(double));
       if (!bigger) {
         fprintf(stderr, "hunting: %s: out of memory\n", path);
-        rc = 1;
+        r = -1;
         break;
       }
       d = bigger;
     }
-    for (int c = 0; c < ncols && rc == 0; ++c) {
-      double *slot = &d[rows * (size_t)ncols + (size_t)c];
-      if (allow_nonfinite ? parse_any_double(fields[c], slot) : parse_double(fields[c], slot)) {
-        fprintf(stderr, "hunting: %s:%zu: column '%s': expected a %snumber, got '%s'\n", path, lineno, header[c],
-                allow_nonfinite ? "" : "finite ", fields[c]);
-        rc = 1;
-      }
-    }
+    if ((r = cli_csv_next(&c, &d[rows * (size_t)ncols])) != 1) break;
     ++rows;
   }
-  if (rc == 0 && ferror(f)) {
-    fprintf(stderr, "hunting: %s: read error\n", path);
-    rc = 1;
-  }
-  fclose(f);
-  if (rc == 0 && !have_header) {
-    fprintf(stderr, "hunting: %s: no header line\n", path);
-    rc = 1;
-  }
-  if (rc != 0) {
+  cli_csv_close(&c);
+  if (r != 0) {
     free(d);
-    return rc;
+    return 1;
   }
+  for (int k = 0; k < ncols; ++k) memcpy(header[k], c.header[k], 64);
   *data = d;
   *n = rows;
   return 0;

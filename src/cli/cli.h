@@ -73,6 +73,20 @@ void jw_finish(json_writer *w);
  */
 int cli_read_csv(const char *path, int ncols, char header[][64], double **data, size_t *n, int allow_nonfinite);
 
+/* The same format read a row at a time (constant memory, for recordings of any length). */
+typedef struct {
+  FILE *f;
+  const char *path;
+  int ncols, allow_nonfinite;
+  size_t lineno;
+  char header[16][64];
+} cli_csv;
+/* Open and read the header; nonzero (message printed) on failure. ncols 1..16. */
+int cli_csv_open(cli_csv *c, const char *path, int ncols, int allow_nonfinite);
+/* The next row into row[ncols]: 1, or 0 at the end, or -1 on an error (message printed). */
+int cli_csv_next(cli_csv *c, double *row);
+void cli_csv_close(cli_csv *c);
+
 /* Commands implemented in cmd_bifurcation.c */
 extern const cli_option hopf_opts[], cycles_opts[], hopf_curve_opts[], lpc_curve_opts[];
 int cmd_hopf(const cli_args *a);

@@ -142,6 +142,49 @@ static int load_settings(const cli_args *a, const double *acc, size_t n_acc, hm_
   return 0;
 }
 
+enum { HEAD_ROWS = 2001 }; /* rows read ahead to infer the sample rate */
+
+/* The speed file's rows up to time t into the monitor (one row of look-ahead in *next, *have_next). */
+static int push_speeds_until(cli_csv *c, double t, double *next, int *have_next, hm_monitor mon) {
+  while (*have_next && next[0] <= t) {
+    hm_monitor_push_speed(mon, next[0], next[1]);
+    const int r = cli_csv_next(c, next);
+    if (r < 0) return 1;
+    *have_next = r == 1;
+  }
+  return 0;
+}
+
+typedef struct {
+  hm_monitor mon;
+  double every, v_const, next_out, t_written, t_last;
+  unsigned long i;
+  cli_csv *spd;
+  double spd_next[2];
+  int spd_have;
+} run_state;
+
+/* One acceleration row through the monitor, a JSON line per output interval. */
+static int process_row(run_state *r, const double *row, int last_row) {
+  const double t = row[0];
+  if (r->spd) {
+    if (push_speeds_until(r->spd, t, r->spd_next, &r->spd_have, r->mon)) return 1;
+  } else if (r->i % 10 == 0) {
+    hm_monitor_push_speed(r->mon, t, r->v_const);
+  }
+  ++r->i;
+  hm_monitor_push_accel(r->mon, t, row[1]);
+  if (isfinite(t)) r->t_last = fmax(r->t_last, t);
+  if (!isfinite(r->next_out) && isfinite(t)) r->next_out = t + r->every;
+  hm_monitor_status st;
+  if (isfinite(t) && (t >= r->next_out || last_row) && hm_monitor_update(r->mon, t, &st) == HM_OK) {
+    write_line(&st, t);
+    r->t_written = t;
+    if (t >= r->next_out) r->next_out = t + r->every - fmod(t - r->next_out, r->every);
+  }
+  return 0;
+}
+
 int cmd_estimate(const cli_args *a) {
   hm_vehicle veh;
   double every = 0.1, v_const = NAN;
@@ -151,69 +194,68 @@ int cmd_estimate(const cli_args *a) {
     fprintf(stderr, "hunting estimate: need --accel FILE and exactly one of --speed FILE or --v KM/H; --every > 0\n");
     return 1;
   }
-  char h_acc[2][64], h_spd[2][64];
-  double *acc = NULL, *spd = NULL;
-  size_t n_acc = 0, n_spd = 0;
-  if (cli_read_csv(accel_path, 2, h_acc, &acc, &n_acc, 1)) return 1;
-  int rc = 0;
-  if (strcmp(h_acc[0], "t_s") != 0 || strcmp(h_acc[1], "accel_mps2") != 0) {
+  if (cli_has(a, "v") && !(v_const > 0.0 && v_const <= 1000.0)) {
+    fprintf(stderr, "hunting estimate: --v must be in (0, 1000] km/h, got %g\n", v_const);
+    return 1;
+  }
+  /* recordings of any length are streamed: only the first HEAD_ROWS rows are held, to infer the sample rate */
+  cli_csv acc, spd;
+  if (cli_csv_open(&acc, accel_path, 2, 1)) return 1;
+  int rc = 0, spd_open = 0;
+  if (strcmp(acc.header[0], "t_s") != 0 || strcmp(acc.header[1], "accel_mps2") != 0) {
     fprintf(stderr, "hunting estimate: %s: the header must be 't_s,accel_mps2'\n", accel_path);
     rc = 1;
   }
-  size_t n_finite = 0;
-  for (size_t i = 0; rc == 0 && i < n_acc; ++i) n_finite += isfinite(acc[2 * i]) != 0;
-  if (rc == 0 && n_finite < 2) {
+  static double head[2 * HEAD_ROWS];
+  size_t n_head = 0, n_finite = 0;
+  int r = 1;
+  while (rc == 0 && n_head < HEAD_ROWS && (r = cli_csv_next(&acc, &head[2 * n_head])) == 1)
+    n_finite += isfinite(head[2 * n_head++]) != 0;
+  if (r < 0) rc = 1;
+  const int ended = r == 0;
+  if (rc == 0 && ended && n_finite < 2) {
     fprintf(stderr, "hunting estimate: %s: %s\n", accel_path,
-            n_acc == 0 ? "no samples (only a header)" : "fewer than two samples with a finite time stamp");
+            n_head == 0 ? "no samples (only a header)" : "fewer than two samples with a finite time stamp");
     rc = 1;
   }
-  if (rc == 0 && cli_has(a, "v") && !(v_const > 0.0 && v_const <= 1000.0)) {
-    fprintf(stderr, "hunting estimate: --v must be in (0, 1000] km/h, got %g\n", v_const);
-    rc = 1;
-  }
+  run_state run = {NULL, every, v_const, NAN, -INFINITY, -INFINITY, 0, NULL, {0.0, 0.0}, 0};
   if (rc == 0 && speed_path) {
-    rc = cli_read_csv(speed_path, 2, h_spd, &spd, &n_spd, 1);
-    if (rc == 0 && (strcmp(h_spd[0], "t_s") != 0 || strcmp(h_spd[1], "speed_kmh") != 0)) {
+    rc = cli_csv_open(&spd, speed_path, 2, 1);
+    spd_open = rc == 0;
+    if (rc == 0 && (strcmp(spd.header[0], "t_s") != 0 || strcmp(spd.header[1], "speed_kmh") != 0)) {
       fprintf(stderr, "hunting estimate: %s: the header must be 't_s,speed_kmh'\n", speed_path);
       rc = 1;
     }
+    if (rc == 0) {
+      const int s = cli_csv_next(&spd, run.spd_next);
+      run.spd_have = s == 1;
+      if (s < 0) rc = 1;
+      run.spd = &spd;
+    }
   }
   hm_monitor_config cfg;
-  hm_monitor mon = NULL;
   hm_table table = NULL;
-  if (rc == 0) rc = load_settings(a, acc, n_acc, &cfg);
+  if (rc == 0) rc = load_settings(a, head, n_head, &cfg);
   if (rc == 0) rc = load_table(a, &table);
   if (rc == 0) {
     char why[256] = "";
-    const hm_status st = hm_monitor_create(&cfg, &veh, table, &mon, why, sizeof why);
+    const hm_status st = hm_monitor_create(&cfg, &veh, table, &run.mon, why, sizeof why);
     if (st != HM_OK) {
-      fprintf(stderr, "hunting estimate: %s%s%s\n", cli_value(a, "table") && strstr(why, "table") ? cli_value(a, "table") : "",
-              cli_value(a, "table") && strstr(why, "table") ? ": not for this vehicle: " : "", *why ? why : hm_status_str(st));
+      const int of_table = cli_value(a, "table") && strstr(why, "table") != NULL;
+      fprintf(stderr, "hunting estimate: %s%s%s\n", of_table ? cli_value(a, "table") : "",
+              of_table ? ": not for this vehicle: " : "", *why ? why : hm_status_str(st));
       rc = 1;
     }
   }
-  size_t k = 0;
-  double next_out = n_acc ? acc[0] + every : 0.0, t_written = -INFINITY, t_last = -INFINITY;
-  hm_monitor_status st;
-  for (size_t i = 0; rc == 0 && i < n_acc; ++i) {
-    const double t = acc[2 * i];
-    if (spd)
-      for (; k < n_spd && spd[2 * k] <= t; ++k) hm_monitor_push_speed(mon, spd[2 * k], spd[2 * k + 1]);
-    else if (i % 10 == 0)
-      hm_monitor_push_speed(mon, t, v_const);
-    hm_monitor_push_accel(mon, t, acc[2 * i + 1]);
-    if (isfinite(t)) t_last = fmax(t_last, t);
-    /* one line per interval of data time, and one at the end of the data */
-    if (isfinite(t) && (t >= next_out || i + 1 == n_acc) && hm_monitor_update(mon, t, &st) == HM_OK) {
-      write_line(&st, t);
-      t_written = t;
-      if (t >= next_out) next_out = t + every - fmod(t - next_out, every);
-    }
+  for (size_t i = 0; rc == 0 && i < n_head; ++i) rc = process_row(&run, &head[2 * i], ended && i + 1 == n_head);
+  double row[2];
+  while (rc == 0 && !ended && (r = cli_csv_next(&acc, row)) != 0) rc = r < 0 ? 1 : process_row(&run, row, 0);
+  if (rc == 0 && isfinite(run.t_last) && run.t_written < run.t_last) { /* one line at the end of the data */
+    hm_monitor_status st;
+    if (hm_monitor_update(run.mon, run.t_last, &st) == HM_OK) write_line(&st, run.t_last);
   }
-  if (rc == 0 && isfinite(t_last) && t_written < t_last && hm_monitor_update(mon, t_last, &st) == HM_OK)
-    write_line(&st, t_last); /* the last rows were not finite times */
-  hm_monitor_destroy(mon);
-  free(acc);
-  free(spd);
+  hm_monitor_destroy(run.mon);
+  cli_csv_close(&acc);
+  if (spd_open) cli_csv_close(&spd);
   return rc;
 }

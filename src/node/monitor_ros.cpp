@@ -120,6 +120,7 @@ void MonitorRos::timeJumped(const std::string& what) {
   last_jump_ = what;
   last_jump_at_ = ros::WallTime::now().toSec();
   ROS_WARN("hunting_monitor: %s: monitor reset, monitoring again after its settling time", what.c_str());
+  updater_.force_update();  // now, and its period restarts on the new time line (it would wait for the old one)
 }
 
 void MonitorRos::checkRosTime(const ros::Time& now) {

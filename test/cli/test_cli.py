@@ -440,6 +440,32 @@ def test_estimate_bad_and_stale_input():
         assert p.returncode == 1 and "hopf_kmh must be in (0, 3000]" in p.stderr, p.stderr
 
 
+def test_estimate_streams_long_recordings():
+    # 25 minutes at 2 kHz (3 million rows, 51 MB): read a row at a time, so the peak memory stays far below the file
+    # (loading it would take 48 MB of doubles, twice that while growing); the last line is at the last sample
+    with tempfile.TemporaryDirectory() as d:
+        acc = os.path.join(d, "long.csv")
+        n = 3_000_000
+        with open(acc, "w") as f:
+            f.write("t_s,accel_mps2\n")
+            step = 100_000
+            for start in range(0, n, step):
+                f.write("".join(f"{i / 2000:.4f},{(i % 29) * 0.01:.2f}\n" for i in range(start, start + step)))
+        # a fresh interpreter whose only child is the tool: its children's peak RSS is the tool's
+        probe = ("import resource, subprocess, sys\n"
+                 "p = subprocess.run(sys.argv[1:], capture_output=True, text=True)\n"
+                 "sys.stdout.write(p.stdout)\n"
+                 "sys.stderr.write(str(resource.getrusage(resource.RUSAGE_CHILDREN).ru_maxrss))\n"
+                 "sys.exit(p.returncode)\n")
+        p = subprocess.run(["/usr/bin/python3", "-c", probe, HUNTING, "estimate", "--accel", acc, "--v", "300",
+                            "--every", "300", "--table", shipped_table()], capture_output=True, text=True, timeout=300)
+        assert p.returncode == 0, p.stderr
+        out = lines(p.stdout)
+        peak_kb = int(p.stderr.strip().splitlines()[-1])
+        close(out[-1]["t_s"], (n - 1) / 2000, 1e-9, "last line at the last sample")
+        assert peak_kb < 30_000, f"peak RSS {peak_kb} kB for a 51 MB recording"
+
+
 def test_write_errors_are_failures():
     if not os.path.exists("/dev/full"):
         return
