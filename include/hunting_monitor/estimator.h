@@ -124,8 +124,8 @@ void hm_estimator_reset(hm_estimator est);
  * for now: a consumer of the same stream (the modal identification) restarts with them. */
 unsigned long hm_estimator_restarts(const hm_estimator est, double *design_rate_hz);
 
-/* One acceleration sample. HM_OK if accepted; HM_EDOMAIN (non-finite or out of range) or HM_EINVAL
- * (timestamp not after the previous one) if rejected and counted; the state is unchanged then. */
+/* One acceleration sample. HM_OK if accepted; HM_EDOMAIN if rejected and counted (non-finite, out of range, or a
+ * timestamp not after the previous one): the state is unchanged then. HM_EINVAL only for a NULL estimator. */
 hm_status hm_estimator_push_accel(hm_estimator est, double t_s, double accel_mps2);
 /* One speed update [km/h]; rejected (HM_EDOMAIN) and counted if implausible. */
 hm_status hm_estimator_push_speed(hm_estimator est, double t_s, double speed_kmh);

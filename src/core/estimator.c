@@ -364,7 +364,7 @@ hm_status hm_estimator_push_accel(hm_estimator e, double t, double a) {
   }
   if (e->have_sample && t <= e->t_last) {
     e->counters.n_rejected_order++;
-    return HM_EINVAL;
+    return HM_EDOMAIN; /* bad data, not caller misuse */
   }
   if (e->have_sample && t - e->t_last > e->cfg.max_gap_s) {
     e->counters.n_gaps++;
