@@ -98,11 +98,6 @@ class Replay(unittest.TestCase):
         stamps = [m.header.stamp.to_sec() for m in self.data_statuses()]
         rate = (len(stamps) - 1) / (stamps[-1] - stamps[0])
         self.assertAlmostEqual(rate, 20.0, delta=1.0)
-        for m in self.status:  # never a NaN
-            for f in ("speed_kmh", "margin_to_hopf_kmh", "amplitude_displacement_m", "frequency_hz",
-                      "conicity_estimate", "rms_accel_mps2"):
-                v = getattr(m, f)
-                self.assertTrue(v == v and abs(v) != float("inf"), f"{f} = {v}")
 
     def test_diagnostics_and_markers(self):
         names = {s.name for a in self.diagnostics for s in a.status}

@@ -101,18 +101,21 @@ static void closed_form_matches_eigenvalue_bisection(void) {
 
 /* Critical conicity: the spectral abscissa (dgeev) is zero there and changes sign across it. */
 static void critical_conicity_is_on_the_boundary(void) {
+  int checked = 0;
   for (int i = 0; i < 200; ++i) {
     hm_vehicle v;
     double lambda, lc, s0, s_lo, s_hi;
     random_vehicle(&v, &lambda);
     const double speed = hm_test_uniform(50.0, 250.0);
     if (hm_linear_critical_conicity(&v, speed, &lc) != HM_OK) continue;
+    ++checked;
     HM_CHECK(hm_linear_spectral_abscissa(&v, lc, speed, &s0) == HM_OK, "abscissa");
     HM_CHECK(hm_linear_spectral_abscissa(&v, lc * (1 - 1e-6), speed, &s_lo) == HM_OK, "abscissa");
     HM_CHECK(hm_linear_spectral_abscissa(&v, lc * (1 + 1e-6), speed, &s_hi) == HM_OK, "abscissa");
     HM_CHECK(fabs(s0) < 1e-7 * 100.0, "abscissa %g at critical conicity", s0);
     HM_CHECK(s_lo < 0.0 && s_hi > 0.0, "no sign change across lambda_c = %g: %g, %g", lc, s_lo, s_hi);
   }
+  HM_CHECK(checked >= 100, "only %d of 200 random vehicles had a critical conicity to check", checked);
   /* and the published pair: at V0 = 536.634923 km/h (Kx = Ky = 8.96) the critical conicity is 0.1271. */
   hm_vehicle v = vehicle_kx_ky(8.96, 8.96);
   double lc;
@@ -135,15 +138,18 @@ static void hurwitz_sign_matches_eigenvalues(void) {
 
 /* At the closed-form critical speed the critical pair's frequency is the closed-form Hopf frequency. */
 static void hopf_frequency_matches_eigenvalues(void) {
+  int checked = 0;
   for (int i = 0; i < 100; ++i) {
     hm_vehicle v;
     double lambda, vc, omega, re[4], im[4];
     random_vehicle(&v, &lambda);
     if (hm_linear_critical_speed(&v, lambda, &vc) != HM_OK) continue;
+    ++checked;
     HM_CHECK(hm_linear_hopf_omega(&v, &omega) == HM_OK, "omega");
     HM_CHECK(hm_linear_eigenvalues(&v, lambda, vc, re, im) == HM_OK, "dgeev");
     HM_CHECK_REL(fabs(im[0]), omega, 1e-7, "Im of the critical pair vs sqrt(A3/A1)");
   }
+  HM_CHECK(checked >= 50, "only %d of 100 random vehicles had a critical speed to check", checked);
 }
 
 /* Bad input: clear status, outputs untouched. */

@@ -111,14 +111,14 @@ static void hunting_onset_alarms_within_a_second(void) {
   /* the unstable cycle at 505 km/h: continuation of the family from the Hopf point */
   hm_hopf_point h;
   size_t n = 0, np = 0, ne = 0;
-  hm_hopf_find(&vehicle, 500.0, HM_PARAM_SPEED, 100.0, 900.0, 1e-10, &h, 1, &n);
+  HM_CHECK(hm_hopf_find(&vehicle, 500.0, HM_PARAM_SPEED, 100.0, 900.0, 1e-10, &h, 1, &n) == HM_OK && n == 1, "Hopf");
   hm_cycle_options o;
   hm_cycle_options_default(&o, HM_PARAM_SPEED);
   o.amp_max_m = 0.009;
   enum { CAP = 4000 };
   hm_cycle_point *pts = malloc(CAP * sizeof *pts);
   hm_cycle_event ev[8];
-  hm_cycles_continue(&vehicle, 500.0, &h, &o, pts, CAP, &np, ev, 8, &ne, NULL);
+  HM_CHECK(hm_cycles_continue(&vehicle, 500.0, &h, &o, pts, CAP, &np, ev, 8, &ne, NULL) == HM_OK, "family");
   const hm_cycle_point *edge = NULL;
   for (size_t i = 1; i < np; ++i) /* the unstable cycle beyond LPC2 crossing 505 km/h */
     if ((pts[i - 1].param - v) * (pts[i].param - v) <= 0.0 && pts[i].amp_y_m > 0.006) edge = &pts[i];

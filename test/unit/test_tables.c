@@ -30,13 +30,15 @@ static void lookup_matches_direct_continuation(void) {
   hm_table_lookup_result r;
   HM_CHECK(hm_table_lookup(table, 0.1358, 420.0, &r) == HM_OK, "lookup");
   printf("  stated errors: speeds %.3f km/h, amplitudes %.3f mm\n", r.error_speed_kmh, r.error_amp_m * 1e3);
-  HM_CHECK_DELTA(r.lowest_cycle_speed_kmh, 239.5, r.error_speed_kmh + 0.1, "lowest cycle speed (MODEL: ~239.5)");
+  /* against MODEL.md section 7 with its own precision (239.5 km/h to 0.05; "about 8.2 mm" to 0.05 mm), and the
+   * fold the continuation locates directly (239.549 km/h, test_cycles), not against the table's own stated error */
+  HM_CHECK_DELTA(r.lowest_cycle_speed_kmh, 239.549, 0.5, "lowest cycle speed (MODEL: 239.5, direct 239.549)");
   HM_CHECK(r.has_edge && r.consistent, "an edge at 420 km/h");
-  HM_CHECK_DELTA(r.edge_amp_m, 8.2e-3, r.error_amp_m + 0.05e-3, "edge at 420 km/h (MODEL: about 8.2 mm)");
+  HM_CHECK_DELTA(r.edge_amp_m, 8.2e-3, 0.1e-3, "edge at 420 km/h (MODEL: about 8.2 mm)");
   /* direct: the family at lambda(0) = 0.1358 */
   hm_hopf_point h;
   size_t n;
-  hm_hopf_find(&vehicle, 500.0, HM_PARAM_SPEED, 100.0, 900.0, 1e-10, &h, 1, &n);
+  HM_CHECK(hm_hopf_find(&vehicle, 500.0, HM_PARAM_SPEED, 100.0, 900.0, 1e-10, &h, 1, &n) == HM_OK && n == 1, "Hopf");
   hm_cycle_options o;
   hm_cycle_options_default(&o, HM_PARAM_SPEED);
   o.p_min = 150.0;
@@ -58,7 +60,9 @@ static void lookup_matches_direct_continuation(void) {
     }
     HM_CHECK(hm_table_lookup(table, 0.1358, speeds[k], &r) == HM_OK, "lookup");
     printf("  V %.0f: edge direct %.4f mm, table %.4f mm\n", speeds[k], edge * 1e3, r.edge_amp_m * 1e3);
-    HM_CHECK_DELTA(r.edge_amp_m, edge, r.error_amp_m, "edge amplitude within the stated error");
+    HM_CHECK(isfinite(edge), "no unstable cycle at %g km/h on the direct family", speeds[k]);
+    /* the interpolation error measured where neighbours agree is about 1 um (README): hold it to 10 um */
+    HM_CHECK_DELTA(r.edge_amp_m, edge, 10e-6, "edge amplitude against direct continuation");
   }
   free(pts);
 }
@@ -75,8 +79,8 @@ static void round_trip(void) {
   size_t need2 = 0;
   HM_CHECK(t2 && hm_table_format(t2, b, need, &need2) == HM_OK && need2 == need && strcmp(a, b) == 0, "same text");
   hm_table_lookup_result r1, r2;
-  hm_table_lookup(table, 0.137, 333.0, &r1);
-  hm_table_lookup(t2, 0.137, 333.0, &r2);
+  HM_CHECK(hm_table_lookup(table, 0.137, 333.0, &r1) == HM_OK && hm_table_lookup(t2, 0.137, 333.0, &r2) == HM_OK,
+           "lookups");
   HM_CHECK_DELTA(r2.edge_amp_m, r1.edge_amp_m, 1e-9, "lookup after round trip");
   hm_table_destroy(t2);
   free(a);
