@@ -120,7 +120,7 @@ int cli_vehicle(const cli_args *a, hm_vehicle *veh, char *name) {
     hm_vehicle_default(&v);
     if (name) strcpy(name, "crh380_default (built-in)");
   }
-  double kx = v.stiffness_long_n_m * 1e-6, ky = v.stiffness_lat_n_m * 1e-6, lambda0 = cli_conicity0(&v);
+  double kx = v.stiffness_long_n_m / 1e6, ky = v.stiffness_lat_n_m / 1e6, lambda0 = cli_conicity0(&v);
   if (cli_number(a, "kx", &kx) || cli_number(a, "ky", &ky) || cli_number(a, "conicity", &lambda0)) return 1;
   v.stiffness_long_n_m = kx * 1e6;
   v.stiffness_lat_n_m = ky * 1e6;
@@ -158,39 +158,66 @@ void jw_init(json_writer *w, FILE *f) {
   w->f = f;
 }
 
+static void jw_escaped(FILE *f, const char *text) {
+  fputc('"', f);
+  for (const char *c = text; *c; ++c) {
+    if (*c == '"' || *c == '\\')
+      fprintf(f, "\\%c", *c);
+    else if ((unsigned char)*c < 0x20)
+      fprintf(f, "\\u%04x", (unsigned)(unsigned char)*c);
+    else
+      fputc(*c, f);
+  }
+  fputc('"', f);
+}
+
 static void jw_prefix(json_writer *w, const char *key) {
   if (w->count[w->depth]++ > 0) fputs(", ", w->f);
-  if (key) fprintf(w->f, "\"%s\": ", key);
+  if (key) {
+    jw_escaped(w->f, key);
+    fputs(": ", w->f);
+  }
 }
 
-void jw_object(json_writer *w, const char *key) {
+int jw_ok(const json_writer *w) { return !w->error; }
+
+static void jw_open(json_writer *w, const char *key, char bracket) {
   jw_prefix(w, key);
-  fputc('{', w->f);
-  if (w->depth < 31) w->count[++w->depth] = 0;
+  fputc(bracket, w->f);
+  if (w->depth < JW_MAX_DEPTH)
+    w->count[++w->depth] = 0;
+  else
+    w->error = 1;
 }
 
-void jw_array(json_writer *w, const char *key) {
-  jw_prefix(w, key);
-  fputc('[', w->f);
-  if (w->depth < 31) w->count[++w->depth] = 0;
+static void jw_close(json_writer *w, char bracket) {
+  fputc(bracket, w->f);
+  if (w->depth > 0)
+    --w->depth;
+  else
+    w->error = 1;
 }
 
-void jw_end_object(json_writer *w) {
-  fputc('}', w->f);
-  if (w->depth > 0) --w->depth;
-}
-
-void jw_end_array(json_writer *w) {
-  fputc(']', w->f);
-  if (w->depth > 0) --w->depth;
-}
+void jw_object(json_writer *w, const char *key) { jw_open(w, key, '{'); }
+void jw_array(json_writer *w, const char *key) { jw_open(w, key, '['); }
+void jw_end_object(json_writer *w) { jw_close(w, '}'); }
+void jw_end_array(json_writer *w) { jw_close(w, ']'); }
 
 void jw_number(json_writer *w, const char *key, double value) {
   jw_prefix(w, key);
-  if (isfinite(value))
-    fprintf(w->f, "%.12g", value);
-  else
+  if (!isfinite(value)) {
     fputs("null", w->f);
+    return;
+  }
+  char buf[32];
+  /* the shortest that reads back as the same double, without an exponent for whole numbers below 1e15 */
+  const double mag = fabs(value);
+  const int digits = mag >= 1.0 && mag < 1e15 ? (int)floor(log10(mag)) + 1 : 1;
+  for (int prec = digits; prec <= 17; ++prec) {
+    snprintf(buf, sizeof buf, "%.*g", prec, value);
+    if (strtod(buf, NULL) == value) break;
+  }
+  fputs(buf, w->f);
 }
 
 void jw_int(json_writer *w, const char *key, long value) {
@@ -200,16 +227,7 @@ void jw_int(json_writer *w, const char *key, long value) {
 
 void jw_string(json_writer *w, const char *key, const char *value) {
   jw_prefix(w, key);
-  fputc('"', w->f);
-  for (const char *c = value; *c; ++c) {
-    if (*c == '"' || *c == '\\')
-      fprintf(w->f, "\\%c", *c);
-    else if ((unsigned char)*c < 0x20)
-      fprintf(w->f, "\\u%04x", (unsigned)(unsigned char)*c);
-    else
-      fputc(*c, w->f);
-  }
-  fputc('"', w->f);
+  jw_escaped(w->f, value);
 }
 
 void jw_bool(json_writer *w, const char *key, int value) {

@@ -41,13 +41,18 @@ double cli_conicity0(const hm_vehicle *veh);
 void cli_print_help(FILE *f, const char *command, const char *usage, const char *summary, const cli_option *opts);
 
 
-/* A small streaming JSON writer: keys are NULL inside arrays. Numbers with 12 significant digits; a
- * non-finite number is written as null (JSON has no NaN). */
+/* A small streaming JSON writer: keys are NULL inside arrays. Numbers in their shortest form that reads back as
+ * the same double (round trip); a non-finite number is written as null (JSON has no NaN); keys and strings escaped.
+ * Nesting deeper than JW_MAX_DEPTH is an error (jw_ok). */
+enum { JW_MAX_DEPTH = 64 };
 typedef struct {
   FILE *f;
   int depth;
-  int count[32]; /* items written at each depth */
+  int error;                    /* nesting too deep or unbalanced */
+  int count[JW_MAX_DEPTH + 1];  /* items written at each depth */
 } json_writer;
+/* 1 if the document written so far is well formed. */
+int jw_ok(const json_writer *w);
 
 void jw_init(json_writer *w, FILE *f);
 void jw_object(json_writer *w, const char *key);

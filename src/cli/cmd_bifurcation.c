@@ -1,4 +1,5 @@
 /* hunting hopf | cycles | hopf-curve | lpc-curve: argument parsing and JSON/CSV output over hopf.h, cycles.h. */
+#define _POSIX_C_SOURCE 200809L /* open_memstream */
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -477,8 +478,17 @@ int cmd_lpc_curve(const cli_args *a) {
     return cli_fail_status("lpc-curve", HM_ENOMEM);
   }
   const char *p2name = hm_param_name(p2);
+  /* the document is built in memory and written only when complete: a failure half-way leaves no broken JSON */
+  char *doc = NULL;
+  size_t doc_len = 0;
+  FILE *mem = open_memstream(&doc, &doc_len);
+  if (!mem) {
+    free(all);
+    free(fam.points);
+    return cli_fail_status("lpc-curve", HM_ENOMEM);
+  }
   json_writer w;
-  jw_init(&w, stdout);
+  jw_init(&w, mem);
   jw_object(&w, NULL);
   jw_string(&w, "plane", plane == HM_PLANE_KY_V ? "ky-v" : "kx-v");
   jw_number(&w, "start", start);
@@ -518,6 +528,9 @@ int cmd_lpc_curve(const cli_args *a) {
   jw_end_array(&w);
   jw_end_object(&w);
   jw_finish(&w);
+  fclose(mem);
+  if (rc == 0 && jw_ok(&w)) fwrite(doc, 1, doc_len, stdout);
+  free(doc);
   free(all);
   free(fam.points);
   return rc;

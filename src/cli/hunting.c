@@ -63,8 +63,8 @@ static int cmd_critical(const cli_args *a) {
   jw_number(&w, "frequency_hz", omega / (2.0 * HM_PI));
   jw_number(&w, "omega_rad_s", omega);
   jw_number(&w, "conicity", lambda);
-  jw_number(&w, "kx_mn_m", veh.stiffness_long_n_m * 1e-6);
-  jw_number(&w, "ky_mn_m", veh.stiffness_lat_n_m * 1e-6);
+  jw_number(&w, "kx_mn_m", veh.stiffness_long_n_m / 1e6);
+  jw_number(&w, "ky_mn_m", veh.stiffness_lat_n_m / 1e6);
   jw_eigenvalues(&w, "eigenvalues", re, im);
   jw_end_object(&w);
   jw_finish(&w);
@@ -368,12 +368,12 @@ static int cmd_sweep(const cli_args *a) {
   if (table) {
     printf("Linear critical (Hopf) speed of the wheelset vs equivalent conicity\n");
     printf("vehicle %s: Kx = %.2f MN/m, Ky = %.2f MN/m; hunting frequency at criticality %.3f Hz\n\n", name,
-           veh.stiffness_long_n_m * 1e-6, veh.stiffness_lat_n_m * 1e-6, omega / (2.0 * HM_PI));
+           veh.stiffness_long_n_m / 1e6, veh.stiffness_lat_n_m / 1e6, omega / (2.0 * HM_PI));
     printf("  conicity   critical speed [km/h]\n");
   } else {
     jw_object(&w, NULL);
-    jw_number(&w, "kx_mn_m", veh.stiffness_long_n_m * 1e-6);
-    jw_number(&w, "ky_mn_m", veh.stiffness_lat_n_m * 1e-6);
+    jw_number(&w, "kx_mn_m", veh.stiffness_long_n_m / 1e6);
+    jw_number(&w, "ky_mn_m", veh.stiffness_lat_n_m / 1e6);
     jw_number(&w, "frequency_hz", omega / (2.0 * HM_PI));
     jw_array(&w, "rows");
   }

@@ -3,6 +3,7 @@
 
 #include <complex.h>
 #include <math.h>
+#include <stdlib.h>
 #include <string.h>
 
 #include "hunting_monitor/linear.h"
@@ -209,8 +210,8 @@ static hm_status delta3_of(double x, double *value, void *ctx) {
 static hm_status fill_point(const hm_vehicle *veh, double speed_kmh, hm_hopf_point *pt) {
   hm_hopf_point out;
   out.speed_kmh = speed_kmh;
-  out.kx_mn_m = veh->stiffness_long_n_m * 1e-6;
-  out.ky_mn_m = veh->stiffness_lat_n_m * 1e-6;
+  out.kx_mn_m = veh->stiffness_long_n_m / 1e6;
+  out.ky_mn_m = veh->stiffness_lat_n_m / 1e6;
   hm_conicity_eval(&veh->conicity, 0.0, &out.conicity, NULL);
   hm_status st = hm_hopf_coefficients(veh, speed_kmh, &out.omega_rad_s, &out.l1, &out.l2);
   if (st != HM_OK) return st;
@@ -241,7 +242,9 @@ hm_status hm_hopf_find(const hm_vehicle *veh, double speed_kmh, hm_param p, doub
     if (st != HM_OK && st != HM_ENOCRIT) return st;
     const double v = hm_kmh_from_mps(v_mps);
     if (st == HM_OK && v >= lo && v <= hi) {
-      if (max_points > 0 && (st = fill_point(veh, v, &points[0])) != HM_OK) return st;
+      hm_hopf_point pt;
+      if (max_points > 0 && (st = fill_point(veh, v, &pt)) != HM_OK) return st;
+      if (max_points > 0) points[0] = pt;
       found = 1;
     }
     *n_found = found;
@@ -249,6 +252,9 @@ hm_status hm_hopf_find(const hm_vehicle *veh, double speed_kmh, hm_param p, doub
   }
   delta3_ctx c = {*veh, speed_kmh, p};
   enum { SAMPLES = 256 };
+  /* the points found go to a local array first: the outputs stay untouched if a later step fails (at most one
+   * root per sample interval) */
+  hm_hopf_point local[SAMPLES];
   double x_prev = lo, g_prev;
   if ((st = delta3_of(lo, &g_prev, &c)) != HM_OK) return st;
   for (int i = 1; i <= SAMPLES; ++i) {
@@ -267,13 +273,14 @@ hm_status hm_hopf_find(const hm_vehicle *veh, double speed_kmh, hm_param p, doub
       double s = speed_kmh;
       hm_param_set(&v, &s, p, root);
       if (is_hopf(&v, s)) {
-        if (found < max_points && (st = fill_point(&v, s, &points[found])) != HM_OK) return st;
+        if (found < max_points && (st = fill_point(&v, s, &local[found])) != HM_OK) return st;
         ++found;
       }
     }
     x_prev = x;
     g_prev = g;
   }
+  for (size_t k = 0; k < found && k < max_points; ++k) points[k] = local[k];
   *n_found = found;
   return HM_OK;
 }
@@ -328,6 +335,10 @@ static int curve_options_valid(const hm_hopf_curve_options *o) {
   return o->plane == HM_PLANE_KX_V || o->plane == HM_PLANE_KY_V;
 }
 
+static hm_status curve_branches(const hm_vehicle *veh, const hm_hopf_curve_options *opt, int n_branch_max,
+                                hm_hopf_curve_point *points, size_t max_points, size_t *np_out, hm_hopf_point *gh,
+                                size_t max_gh, size_t *ng_out);
+
 hm_status hm_hopf_curve(const hm_vehicle *veh, const hm_hopf_curve_options *opt, hm_hopf_curve_point *points,
                         size_t max_points, size_t *n_points_out, hm_hopf_point *gh, size_t max_gh, size_t *n_gh) {
   if (!veh || !opt || !n_points_out || !n_gh || !curve_options_valid(opt)) return HM_EINVAL;
@@ -335,6 +346,31 @@ hm_status hm_hopf_curve(const hm_vehicle *veh, const hm_hopf_curve_options *opt,
   hm_status st = hm_vehicle_validate(veh, NULL, 0);
   if (st != HM_OK) return st;
   const int n_branch_max = opt->plane == HM_PLANE_KX_KY ? 2 : 1;
+  size_t np = 0, ng = 0;
+  /* results go to work copies first, so that the outputs stay untouched when a later step fails */
+  hm_hopf_curve_point *pts = max_points ? malloc(max_points * sizeof *pts) : NULL;
+  hm_hopf_point *ghs = max_gh ? malloc(max_gh * sizeof *ghs) : NULL;
+  if ((max_points && !pts) || (max_gh && !ghs)) {
+    free(pts);
+    free(ghs);
+    return HM_ENOMEM;
+  }
+  st = curve_branches(veh, opt, n_branch_max, pts, max_points, &np, ghs, max_gh, &ng);
+  if (st == HM_OK) {
+    if (np) memcpy(points, pts, (np < max_points ? np : max_points) * sizeof *pts);
+    if (ng) memcpy(gh, ghs, (ng < max_gh ? ng : max_gh) * sizeof *ghs);
+    *n_points_out = np;
+    *n_gh = ng;
+  }
+  free(pts);
+  free(ghs);
+  return st;
+}
+
+static hm_status curve_branches(const hm_vehicle *veh, const hm_hopf_curve_options *opt, int n_branch_max,
+                                hm_hopf_curve_point *points, size_t max_points, size_t *np_out, hm_hopf_point *gh,
+                                size_t max_gh, size_t *ng_out) {
+  hm_status st;
   size_t np = 0, ng = 0;
   for (int b = 0; b < n_branch_max; ++b) {
     curve_ctx c = {veh, opt, b};
@@ -365,7 +401,7 @@ hm_status hm_hopf_curve(const hm_vehicle *veh, const hm_hopf_curve_options *opt,
       l1_prev = pt.l1;
     }
   }
-  *n_points_out = np;
-  *n_gh = ng;
+  *np_out = np;
+  *ng_out = ng;
   return HM_OK;
 }

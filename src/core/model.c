@@ -52,8 +52,8 @@ hm_status hm_vehicle_validate(const hm_vehicle *veh, char *why, size_t why_len) 
       {"vehicle.creep_long_n", veh->creep_long_n, 0},
       {"vehicle.creep_lat_n", veh->creep_lat_n, 0},
       {"vehicle.spring_ratio", veh->spring_ratio, 0},
-      {"vehicle.kx_mn_m", veh->stiffness_long_n_m * 1e-6, 0},
-      {"vehicle.ky_mn_m", veh->stiffness_lat_n_m * 1e-6, 1},
+      {"vehicle.kx_mn_m", veh->stiffness_long_n_m / 1e6, 0},
+      {"vehicle.ky_mn_m", veh->stiffness_lat_n_m / 1e6, 1},
       {"conicity.constant", veh->conicity.constant, 1},
   };
   for (size_t i = 0; i < sizeof pos / sizeof pos[0]; ++i) {
@@ -195,8 +195,8 @@ double hm_param_get(const hm_vehicle *veh, double speed_kmh, hm_param p) {
   double l0;
   switch (p) {
     case HM_PARAM_SPEED: return speed_kmh;
-    case HM_PARAM_KX: return veh->stiffness_long_n_m * 1e-6;
-    case HM_PARAM_KY: return veh->stiffness_lat_n_m * 1e-6;
+    case HM_PARAM_KX: return veh->stiffness_long_n_m / 1e6;
+    case HM_PARAM_KY: return veh->stiffness_lat_n_m / 1e6;
     case HM_PARAM_CONICITY: hm_conicity_eval(&veh->conicity, 0.0, &l0, NULL); return l0;
   }
   return NAN;

@@ -278,7 +278,7 @@ hm_status hm_table_check_vehicle(const hm_table t, const hm_vehicle *veh, double
   if (!t || !veh || !(tol_kmh > 0.0)) return HM_EINVAL;
   hm_status st = hm_vehicle_validate(veh, why, len);
   if (st != HM_OK) return st;
-  const double kx = veh->stiffness_long_n_m * 1e-6, ky = veh->stiffness_lat_n_m * 1e-6;
+  const double kx = veh->stiffness_long_n_m / 1e6, ky = veh->stiffness_lat_n_m / 1e6;
   if (fabs(t->kx_mn_m - kx) > 1e-6 * kx || fabs(t->ky_mn_m - ky) > 1e-6 * ky) {
     if (why && len)
       snprintf(why, len, "table made for Kx %g, Ky %g MN/m, vehicle has Kx %g, Ky %g MN/m", t->kx_mn_m, t->ky_mn_m,
@@ -305,8 +305,8 @@ hm_status hm_table_build(const hm_vehicle *veh, const hm_table_spec *spec, hm_ta
   if (st != HM_OK) return st;
   hm_table t = table_alloc(spec->n_conicity);
   if (!t) return HM_ENOMEM;
-  t->kx_mn_m = veh->stiffness_long_n_m * 1e-6;
-  t->ky_mn_m = veh->stiffness_lat_n_m * 1e-6;
+  t->kx_mn_m = veh->stiffness_long_n_m / 1e6;
+  t->ky_mn_m = veh->stiffness_lat_n_m / 1e6;
   t->speed_min_kmh = spec->speed_min_kmh;
   t->speed_max_kmh = spec->speed_max_kmh;
   t->amp_max_m = spec->amp_max_m;

@@ -470,6 +470,20 @@ def test_estimate_streams_long_recordings():
         assert peak_kb < 30_000, f"peak RSS {peak_kb} kB for a 51 MB recording"
 
 
+def test_json_numbers_round_trip():
+    # numbers are written in their shortest form that reads back as the same double: a configured 8.96 MN/m comes
+    # out as 8.96, a whole speed without an exponent, and a computed critical speed with every digit it needs (the
+    # printed value, read back, gives back the same eigenvalue pair on the boundary)
+    out = run_json("critical", "--kx", "8.96", "--ky", "8.96")
+    raw = run("critical", "--kx", "8.96", "--ky", "8.96").stdout
+    assert '"kx_mn_m": 8.96,' in raw and out["kx_mn_m"] == 8.96, raw
+    assert '"v_kmh": 400,' in run("eig", "--v", "400").stdout
+    v = out["v_crit_kmh"]
+    assert repr(v) in raw, (repr(v), raw)  # Python's repr is the shortest round-trip form too
+    eig = run_json("eig", "--v", repr(v))["eigenvalues"][0]
+    assert abs(eig[0]) < 1e-9 * abs(eig[1]), eig
+
+
 def test_write_errors_are_failures():
     if not os.path.exists("/dev/full"):
         return
