@@ -7,9 +7,13 @@
  * flange contact depend on the position on the rail), the suspension terms keep y (relative to the bogie):
  *   x2' = -(Kx/m)(l0/l1 - 1) y - (Ky/m) y - 2 ky/(m v) x2 + 2 ky/m x3 - F_T(y_r)/m
  *   x4' = -(2 d0 kx lambda(y_r)/(I r0)) y_r - (Kx d1^2/I) x3 - (2 d0^2 kx/(I v)) x4
- * y_t is a sum of sinusoids in distance with random phases whose amplitudes follow the German high-speed
- * track alignment spectrum for low disturbance, S(W) = A Wc^2 / ((W^2 + Wr^2)(W^2 + Wc^2)) with A = 2.119e-7 m rad,
- * Wc = 0.8246 rad/m, Wr = 0.0206 rad/m (one-sided, W the spatial angular frequency), times a scale.
+ * y_t is a Gaussian random process in distance with the German high-speed track alignment spectrum for low
+ * disturbance, S(W) = A Wc^2 / ((W^2 + Wr^2)(W^2 + Wc^2)) with A = 2.119e-7 m rad, Wc = 0.8246 rad/m,
+ * Wr = 0.0206 rad/m (one-sided, W the spatial angular frequency), times a scale, between two wavelengths: every
+ * Fourier line of a 26 km periodic track (spacing 2.4e-4 rad/m, far finer than any resonance the wheelset has at
+ * service speeds) with a complex Gaussian amplitude, by one inverse FFT onto a 0.1 m grid, linearly interpolated.
+ * (An earlier sum of 200 sinusoids evenly spaced in wavelength left lines 0.8 Hz apart at 14 Hz and 500 km/h: the
+ * lightly damped hunting mode then answered at the nearest line, not at its own frequency.)
  */
 #ifndef HUNTING_MONITOR_EXCITATION_H
 #define HUNTING_MONITOR_EXCITATION_H
@@ -24,31 +28,29 @@
 extern "C" {
 #endif
 
-#define HM_IRREGULARITY_MAX_TERMS 256
+typedef struct hm_track_s *hm_track;
 
-typedef struct {
-  size_t n;
-  double amplitude_m[HM_IRREGULARITY_MAX_TERMS];
-  double wavenumber_rad_m[HM_IRREGULARITY_MAX_TERMS];
-  double phase_rad[HM_IRREGULARITY_MAX_TERMS];
-} hm_irregularity;
-
-/* n terms (1..256) evenly spaced in wavelength between wavelength_min_m and wavelength_max_m, amplitudes from
- * the spectrum times sqrt(scale) (scale 1: the low-disturbance spectrum), phases from seed. */
-hm_status hm_irregularity_generate(hm_irregularity *irr, size_t n, double wavelength_min_m, double wavelength_max_m,
-                                   double scale, uint64_t seed);
-/* y_t at distance s [m]. */
-double hm_irregularity_at(const hm_irregularity *irr, double s_m);
+/* A track (allocates about 2 MB) with the spectrum above times scale (>= 0) between wavelength_min_m and
+ * wavelength_max_m (0.2 <= min < max <= 1000), its random amplitudes and phases from seed. HM_EINVAL for bad
+ * arguments, HM_ENOMEM. */
+hm_status hm_track_create(double wavelength_min_m, double wavelength_max_m, double scale, uint64_t seed,
+                          hm_track *out);
+void hm_track_destroy(hm_track track);
+/* y_t [m] at distance s [m] (the track repeats every 26.2 km). */
+double hm_track_at(const hm_track track, double s_m);
+/* Its r.m.s. [m] and the one the spectrum gives over the band (they agree to the sampling of the amplitudes). */
+double hm_track_rms_m(const hm_track track);
+double hm_track_spectrum_rms_m(double wavelength_min_m, double wavelength_max_m, double scale);
 
 typedef struct {
   hm_model model;                /* vehicle; its speed is set from the profile at each evaluation */
-  const hm_irregularity *irr;    /* may be NULL: a perfect track */
+  hm_track track;                /* borrowed; may be NULL: a perfect track */
   double v_start_kmh, v_end_kmh; /* speed ramps linearly from v_start to v_end over ramp_s, then stays */
   double ramp_s;
 } hm_excited_model;
 
-/* Fill em (validates the vehicle and speeds > 0; ramp_s >= 0). irr is borrowed. */
-hm_status hm_excited_model_init(hm_excited_model *em, const hm_vehicle *veh, const hm_irregularity *irr,
+/* Fill em (validates the vehicle and speeds > 0; ramp_s >= 0). track is borrowed. */
+hm_status hm_excited_model_init(hm_excited_model *em, const hm_vehicle *veh, const hm_track track,
                                 double v_start_kmh, double v_end_kmh, double ramp_s);
 double hm_excited_speed_kmh(const hm_excited_model *em, double t_s);
 double hm_excited_distance_m(const hm_excited_model *em, double t_s);

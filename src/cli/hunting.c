@@ -243,15 +243,18 @@ static int cmd_simulate(const cli_args *a) {
     hm_vehicle_linearized(&veh, &lin);
     veh = lin;
   }
-  hm_irregularity irr;
-  if (scale > 0.0 && hm_irregularity_generate(&irr, 200, 3.0, 120.0, scale, (uint64_t)seed) != HM_OK)
-    return fail_status("irregularity", HM_EINVAL);
+  hm_track track = NULL;
+  hm_status st = scale > 0.0 ? hm_track_create(3.0, 120.0, scale, (uint64_t)seed, &track) : HM_OK;
+  if (st != HM_OK) return fail_status("track irregularity", st);
   hm_excited_model em;
-  hm_status st = hm_excited_model_init(&em, &veh, scale > 0.0 ? &irr : NULL, v_kmh, v_end, t_end);
-  if (st != HM_OK) return fail_status("model", st);
+  if ((st = hm_excited_model_init(&em, &veh, track, v_kmh, v_end, t_end)) != HM_OK) {
+    hm_track_destroy(track);
+    return fail_status("model", st);
+  }
   FILE *out = NULL, *acc = NULL, *spd = NULL;
   if (open_outputs(a, &out, &acc, &spd)) {
     close_outputs(a, out, acc, spd);
+    hm_track_destroy(track);
     return 1;
   }
   fprintf(out, "t_s,y_m,dy_mps,psi_rad,dpsi_radps,accel_lat_mps2\n");
@@ -262,12 +265,14 @@ static int cmd_simulate(const cli_args *a) {
   hm_dopri integ = hm_dopri_create(4);
   if (!integ) {
     close_outputs(a, out, acc, spd);
+    hm_track_destroy(track);
     return fail_status("integrator", HM_ENOMEM);
   }
   const hm_ode_system sys = {4, hm_excited_rhs, NULL, &em};
   const hm_dopri_options opt = {rtol, atol, 0.0, scale > 0.0 ? 2e-3 : 0.0, 0};
   st = hm_dopri_integrate(integ, &sys, &opt, 0.0, t_end, x, NULL, sim_observer, &w, NULL);
   hm_dopri_destroy(integ);
+  hm_track_destroy(track);
   if (st == HM_OK || w.error == HM_EIO) st = w.error;
   if (close_outputs(a, out, acc, spd) || st == HM_EIO) return 1;
   if (st != HM_OK) return fail_status("simulation (the trajectory diverged or the step size collapsed)", st);

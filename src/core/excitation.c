@@ -2,9 +2,11 @@
 #include "hunting_monitor/excitation.h"
 
 #include <math.h>
+#include <stdlib.h>
 #include <string.h>
 
 #include "hunting_monitor/linear.h"
+#include "fft.h"
 
 /* German high-speed alignment spectrum, low disturbance: S(W) = A Wc^2 / ((W^2 + Wr^2)(W^2 + Wc^2)). */
 static double alignment_psd(double w) {
@@ -17,36 +19,93 @@ static double uniform01(uint64_t *s) { /* splitmix64 */
   z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9ull;
   z = (z ^ (z >> 27)) * 0x94D049BB133111EBull;
   z ^= z >> 31;
-  return (double)(z >> 11) / 9007199254740992.0;
+  return ((double)(z >> 11) + 0.5) / 9007199254740992.0;
 }
 
-hm_status hm_irregularity_generate(hm_irregularity *irr, size_t n, double wl_min, double wl_max, double scale,
-                                   uint64_t seed) {
-  if (!irr || n < 1 || n > HM_IRREGULARITY_MAX_TERMS || !(wl_min > 0.0) || !(wl_max > wl_min) || !isfinite(wl_max) ||
-      !(scale >= 0.0) || !isfinite(scale))
+static double gaussian(uint64_t *s) { /* Box-Muller */
+  const double u1 = uniform01(s), u2 = uniform01(s);
+  return sqrt(-2.0 * log(u1)) * cos(2.0 * HM_PI * u2);
+}
+
+enum { TRACK_LOG2_N = 18 };                 /* 262144 points */
+static const double TRACK_DS_M = 0.1;      /* grid spacing: 30 points over the shortest 3 m wavelength */
+
+struct hm_track_s {
+  size_t n;
+  double ds_m, length_m, rms_m;
+  double *y;
+};
+
+double hm_track_spectrum_rms_m(double wl_min, double wl_max, double scale) {
+  /* the integral of S(W) = A Wc^2 / ((W^2 + Wr^2)(W^2 + Wc^2)) in closed form (partial fractions) */
+  const double A = 2.119e-7, wc = 0.8246, wr = 0.0206;
+  const double w_lo = 2.0 * HM_PI / wl_max, w_hi = 2.0 * HM_PI / wl_min;
+  const double k = A * wc * wc / (wc * wc - wr * wr);
+  const double var = k * ((atan(w_hi / wr) - atan(w_lo / wr)) / wr - (atan(w_hi / wc) - atan(w_lo / wc)) / wc);
+  return sqrt(fmax(scale * var, 0.0));
+}
+
+hm_status hm_track_create(double wl_min, double wl_max, double scale, uint64_t seed, hm_track *out) {
+  if (!out || !(wl_min >= 0.2) || !(wl_max > wl_min) || !(wl_max <= 1000.0) || !(scale >= 0.0) || !isfinite(scale))
     return HM_EINVAL;
-  hm_irregularity out;
-  memset(&out, 0, sizeof out);
-  out.n = n;
-  const double w_lo = 2.0 * HM_PI / wl_max, w_hi = 2.0 * HM_PI / wl_min, dw = (w_hi - w_lo) / (double)n;
-  uint64_t s = seed;
-  for (size_t k = 0; k < n; ++k) {
-    const double w = w_lo + ((double)k + 0.5) * dw;
-    out.wavenumber_rad_m[k] = w;
-    out.amplitude_m[k] = sqrt(2.0 * scale * alignment_psd(w) * dw); /* variance S dW per component */
-    out.phase_rad[k] = 2.0 * HM_PI * uniform01(&s);
+  const size_t n = (size_t)1 << TRACK_LOG2_N;
+  hm_track t = calloc(1, sizeof *t);
+  double *re = malloc(n * sizeof(double)), *im = malloc(n * sizeof(double));
+  double *cw = malloc(n / 2 * sizeof(double)), *sw = malloc(n / 2 * sizeof(double));
+  if (!t || !re || !im || !cw || !sw) {
+    free(t);
+    free(re);
+    free(im);
+    free(cw);
+    free(sw);
+    return HM_ENOMEM;
   }
-  *irr = out;
+  t->n = n;
+  t->ds_m = TRACK_DS_M;
+  t->length_m = (double)n * TRACK_DS_M;
+  /* line k at W_k = 2 pi k / L with a complex Gaussian amplitude of variance S(W_k) dW scale: y = sum 2 Re(Y_k
+   * e^{i W_k s}) has the spectrum's variance over the band; the inverse transform is the forward one conjugated */
+  const double dw = 2.0 * HM_PI / t->length_m;
+  uint64_t rng = seed * 0x2545F4914F6CDD1Dull + 7u;
+  for (size_t k = 0; k < n; ++k) re[k] = im[k] = 0.0;
+  for (size_t k = 1; k < n / 2; ++k) {
+    const double w = dw * (double)k;
+    if (w < 2.0 * HM_PI / wl_max || w > 2.0 * HM_PI / wl_min) continue;
+    const double c = sqrt(scale * alignment_psd(w) * dw) / 2.0;
+    re[k] = 2.0 * c * gaussian(&rng);
+    im[k] = -2.0 * c * gaussian(&rng); /* conjugated for the inverse */
+  }
+  hm_fft_twiddles(cw, sw, n);
+  hm_fft(re, im, n, cw, sw, n);
+  double ss = 0.0;
+  for (size_t j = 0; j < n; ++j) ss += re[j] * re[j]; /* the real part of the conjugated result */
+  t->rms_m = sqrt(ss / (double)n);
+  t->y = re;
+  free(im);
+  free(cw);
+  free(sw);
+  *out = t;
   return HM_OK;
 }
 
-double hm_irregularity_at(const hm_irregularity *irr, double s_m) {
-  double y = 0.0;
-  for (size_t k = 0; k < irr->n; ++k) y += irr->amplitude_m[k] * sin(irr->wavenumber_rad_m[k] * s_m + irr->phase_rad[k]);
-  return y;
+void hm_track_destroy(hm_track t) {
+  if (!t) return;
+  free(t->y);
+  free(t);
 }
 
-hm_status hm_excited_model_init(hm_excited_model *em, const hm_vehicle *veh, const hm_irregularity *irr,
+double hm_track_at(const hm_track t, double s) {
+  double u = fmod(s, t->length_m);
+  if (u < 0.0) u += t->length_m;
+  const double x = u / t->ds_m;
+  const size_t i = (size_t)x % t->n;
+  const double f = x - floor(x);
+  return t->y[i] + f * (t->y[(i + 1) % t->n] - t->y[i]);
+}
+
+double hm_track_rms_m(const hm_track t) { return t ? t->rms_m : 0.0; }
+
+hm_status hm_excited_model_init(hm_excited_model *em, const hm_vehicle *veh, const hm_track track,
                                 double v_start_kmh, double v_end_kmh, double ramp_s) {
   if (!em || !veh) return HM_EINVAL;
   if (!(v_start_kmh > 0.0) || !(v_end_kmh > 0.0) || !isfinite(v_start_kmh) || !isfinite(v_end_kmh) ||
@@ -55,7 +114,7 @@ hm_status hm_excited_model_init(hm_excited_model *em, const hm_vehicle *veh, con
   hm_excited_model out;
   hm_status st = hm_model_init(&out.model, veh, hm_mps_from_kmh(v_start_kmh));
   if (st != HM_OK) return st;
-  out.irr = irr;
+  out.track = track;
   out.v_start_kmh = v_start_kmh;
   out.v_end_kmh = v_end_kmh;
   out.ramp_s = ramp_s;
@@ -79,9 +138,9 @@ double hm_excited_distance_m(const hm_excited_model *em, double t) {
 hm_status hm_excited_rhs(double t, const double *x, double *dxdt, void *params) {
   hm_excited_model *em = (hm_excited_model *)params;
   em->model.speed_mps = hm_mps_from_kmh(hm_excited_speed_kmh(em, t));
-  if (!em->irr) return hm_model_rhs(t, x, dxdt, &em->model);
+  if (!em->track) return hm_model_rhs(t, x, dxdt, &em->model);
   /* the wheel-rail terms see y - y_t; evaluate them at the relative displacement and add the suspension part */
-  const double yt = hm_irregularity_at(em->irr, hm_excited_distance_m(em, t));
+  const double yt = hm_track_at(em->track, hm_excited_distance_m(em, t));
   const double xr[4] = {x[0] - yt, x[1], x[2], x[3]};
   double fr[4];
   hm_status st = hm_model_rhs(t, xr, fr, &em->model);

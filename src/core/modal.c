@@ -7,6 +7,7 @@
 #include <string.h>
 
 #include "biquad.h"
+#include "fft.h"
 
 enum { NP = 6 }; /* sigma, w0, c0, c1, c2, ln N */
 enum { P_SIGMA, P_W0, P_C0, P_C1, P_C2, P_LN };
@@ -111,6 +112,7 @@ hm_status hm_modal_create(const hm_modal_config *cfg, double fs, hm_modal *out, 
     hm_modal_destroy(m);
     return HM_ENOMEM;
   }
+  hm_fft_twiddles(m->cosw, m->sinw, m->nfft_max);
   apply_rate(m, fs, r, fd);
   *out = m;
   return HM_OK;
@@ -162,45 +164,6 @@ void hm_modal_push(hm_modal m, double a) {
 
 int hm_modal_fit_due(const hm_modal m) {
   return m && (double)m->n_in >= m->cfg.min_window_s * m->fd && (double)m->since_fit >= m->cfg.fit_interval_s * m->fd;
-}
-
-/* In-place radix-2 complex FFT of length n (a power of two <= nfft_max), twiddles for nfft_max. */
-static void fft(hm_modal m, size_t n) {
-  double *re = m->re, *im = m->im;
-  for (size_t i = 1, j = 0; i < n; ++i) { /* bit reversal */
-    size_t bit = n >> 1;
-    for (; j & bit; bit >>= 1) j ^= bit;
-    j |= bit;
-    if (i < j) {
-      double t = re[i];
-      re[i] = re[j];
-      re[j] = t;
-      t = im[i];
-      im[i] = im[j];
-      im[j] = t;
-    }
-  }
-  for (size_t len = 2; len <= n; len <<= 1) {
-    const size_t stride = m->nfft_max / len;
-    for (size_t i = 0; i < n; i += len)
-      for (size_t k = 0; k < len / 2; ++k) {
-        const double c = m->cosw[k * stride], s = -m->sinw[k * stride];
-        const size_t a = i + k, b = i + k + len / 2;
-        const double tr = re[b] * c - im[b] * s, ti = re[b] * s + im[b] * c;
-        re[b] = re[a] - tr;
-        im[b] = im[a] - ti;
-        re[a] += tr;
-        im[a] += ti;
-      }
-  }
-}
-
-static void twiddles(hm_modal m) {
-  if (m->cosw[0] == 1.0) return; /* computed once */
-  for (size_t k = 0; k < m->nfft_max / 2; ++k) {
-    m->cosw[k] = cos(2.0 * HM_PI * (double)k / (double)m->nfft_max);
-    m->sinw[k] = sin(2.0 * HM_PI * (double)k / (double)m->nfft_max);
-  }
 }
 
 /* ln S_k and its gradient for bin k. */
@@ -347,7 +310,6 @@ hm_status hm_modal_fit(hm_modal m, double max_window_s, hm_mode_estimate *out) {
     *out = r;
     return HM_OK;
   }
-  twiddles(m);
   /* the newest n samples, oldest first, without their mean, zero-padded */
   const size_t oldest = (m->head + m->n_win - n) % m->n_win;
   double mean = 0.0;
@@ -357,7 +319,7 @@ hm_status hm_modal_fit(hm_modal m, double max_window_s, hm_mode_estimate *out) {
     m->re[k] = k < n ? m->ring[(oldest + k) % m->n_win] - mean : 0.0;
     m->im[k] = 0.0;
   }
-  fft(m, m->nfft);
+  hm_fft(m->re, m->im, m->nfft, m->cosw, m->sinw, m->nfft_max);
   /* the band's bins, the periodogram scaled to mean 1 (the fit is scale-free; it keeps exp() in range) */
   const double df = m->fd / (double)m->nfft, w_ref = 2.0 * HM_PI * 0.5 * (m->cfg.band_low_hz + m->cfg.band_high_hz);
   size_t nb = 0;

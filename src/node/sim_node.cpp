@@ -19,7 +19,7 @@ namespace {
 
 struct Sim {
   hm_excited_model em{};
-  hm_irregularity irr{};
+  hm_track track = nullptr;
   hm_dopri integ = nullptr;
   double x[4] = {0, 0, 0, 0};
   double t = 0.0;               // model time [s] since the start
@@ -85,8 +85,8 @@ int main(int argc, char** argv) {
               "100..5000 and accel_noise_mps2 >= 0");
     return 1;
   }
-  if (hm_irregularity_generate(&sim.irr, 200, 3.0, 120.0, scale, static_cast<uint64_t>(seed)) != HM_OK ||
-      hm_excited_model_init(&sim.em, &veh, scale > 0 ? &sim.irr : nullptr, v_start, v_end, ramp_s) != HM_OK ||
+  if ((scale > 0 && hm_track_create(3.0, 120.0, scale, static_cast<uint64_t>(seed), &sim.track) != HM_OK) ||
+      hm_excited_model_init(&sim.em, &veh, sim.track, v_start, v_end, ramp_s) != HM_OK ||
       !(sim.integ = hm_dopri_create(4))) {
     ROS_FATAL("hunting_sim: cannot set up the model");
     return 1;
@@ -126,6 +126,7 @@ int main(int argc, char** argv) {
     loop.sleep();
   }
   hm_dopri_destroy(sim.integ);
+  hm_track_destroy(sim.track);
   ROS_INFO("hunting_sim: scenario finished after %.1f s", sim.t);
   return 0;
 }

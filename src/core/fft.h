@@ -1,0 +1,13 @@
+/* Private: an in-place radix-2 complex FFT (forward, e^{-i}), shared by the hunting-mode identification and the
+ * track generator. Twiddles for the largest size nmax (a power of two) serve every smaller power of two. */
+#ifndef HUNTING_MONITOR_FFT_H
+#define HUNTING_MONITOR_FFT_H
+
+#include <stddef.h>
+
+/* cosw, sinw: nmax / 2 values each. */
+void hm_fft_twiddles(double *cosw, double *sinw, size_t nmax);
+/* n a power of two <= nmax. */
+void hm_fft(double *re, double *im, size_t n, const double *cosw, const double *sinw, size_t nmax);
+
+#endif
