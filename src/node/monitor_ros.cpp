@@ -40,8 +40,8 @@ MonitorRos::MonitorRos(ros::NodeHandle nh, ros::NodeHandle pnh) : nh_(nh), pnh_(
   updater_.add("hunting level", this, &MonitorRos::diagnoseLevel);
   timer_ = nh_.createTimer(ros::Duration(1.0 / status_rate_hz_), &MonitorRos::onTimer, this);
   ok_ = true;
-  ROS_INFO("hunting_monitor: ready (accel %s at %.0f Hz, speed in %s, status at %.1f Hz, table %s)",
-           accel_type_.c_str(), cfg_.estimator.sample_rate_hz, speed_unit_.c_str(), status_rate_hz_,
+  ROS_INFO("hunting_monitor: ready (accel %s at %.0f Hz stamped by %s time, speed in %s, status at %.1f Hz, table %s)",
+           accel_type_.c_str(), cfg_.estimator.sample_rate_hz, time_source_.c_str(), speed_unit_.c_str(), status_rate_hz_,
            table_file_.c_str());
 }
 
@@ -64,6 +64,7 @@ bool MonitorRos::loadParameters() {
   }
   pnh_.param<std::string>("accel_type", accel_type_, "imu");
   pnh_.param<std::string>("imu_axis", imu_axis_, "y");
+  pnh_.param<std::string>("time_source", time_source_, "header");
   pnh_.param<std::string>("speed_unit", speed_unit_, "kmh");
   pnh_.param<std::string>("frame_id", frame_id_, "base_link");
   pnh_.param<std::string>("table_file", table_file_, "");
@@ -77,7 +78,14 @@ bool MonitorRos::loadParameters() {
     ROS_FATAL("hunting_monitor: ~accel_type must be imu or float64, got '%s'", accel_type_.c_str());
     return false;
   }
-  if (imu_axis_ != "x" && imu_axis_ != "y" && imu_axis_ != "z") {
+  if (time_source_ != "header" && time_source_ != "receipt") {
+    ROS_FATAL("hunting_monitor: ~time_source must be header or receipt, got '%s'", time_source_.c_str());
+    return false;
+  }
+  if (accel_type_ == "float64" && time_source_ == "header") time_source_ = "receipt";  // a Float64 has no header
+  header_time_ = time_source_ == "header";
+  axis_ = imu_axis_ == "x" ? 0 : imu_axis_ == "y" ? 1 : imu_axis_ == "z" ? 2 : -1;
+  if (axis_ < 0) {
     ROS_FATAL("hunting_monitor: ~imu_axis must be x, y or z, got '%s'", imu_axis_.c_str());
     return false;
   }
@@ -167,9 +175,9 @@ void MonitorRos::onAccelFloat(const std_msgs::Float64::ConstPtr& msg) {
 void MonitorRos::onAccelImu(const sensor_msgs::Imu::ConstPtr& msg) {
   const ros::Time now = ros::Time::now();
   checkRosTime(now);
-  const double t = sensorTime(msg->header.stamp.toSec(), now.toSec());
+  const double t = header_time_ ? sensorTime(msg->header.stamp.toSec(), now.toSec()) : now.toSec();
   const auto& a = msg->linear_acceleration;
-  if (std::isfinite(t)) pushAccel(t, imu_axis_ == "x" ? a.x : imu_axis_ == "y" ? a.y : a.z);
+  if (std::isfinite(t)) pushAccel(t, axis_ == 0 ? a.x : axis_ == 1 ? a.y : a.z);
 }
 
 void MonitorRos::onSpeed(const std_msgs::Float64::ConstPtr& msg) {

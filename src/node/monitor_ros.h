@@ -46,7 +46,9 @@ class MonitorRos {
   ros::NodeHandle nh_, pnh_;
   bool ok_ = false;
   // parameters
-  std::string accel_type_, imu_axis_, speed_unit_, frame_id_, table_file_;
+  std::string accel_type_, imu_axis_, speed_unit_, frame_id_, table_file_, time_source_;
+  int axis_ = 1;                  // ~imu_axis resolved once: 0 x, 1 y, 2 z
+  bool header_time_ = true;       // ~time_source: Imu header stamps (true) or receipt time
   double status_rate_hz_ = 20.0;
   hm_vehicle vehicle_{};
   hm_monitor_config cfg_{};

@@ -168,6 +168,8 @@ class Robustness(unittest.TestCase):
             ("bad_type", [], ["_accel_type:=twist"], "~accel_type must be imu or float64"),
             ("bad_table", [("vehicle", "kx_mn_m", 9.7)], [], "table made for Kx 8.96"),
             ("bad_key", [("vehicle", "mas_kg", 1)], [], "vehicle.mas_kg: unknown key"),
+            ("bad_time", [], ["_time_source:=gps"], "~time_source must be header or receipt"),
+            ("bad_offset", [], ["_max_clock_offset_s:=-1"], "~max_clock_offset_s must be in (0, 3600]"),
         ]
         for name, changes, extra, message in cases:
             code, out = self.run_bad_node(name, changes, extra)
