@@ -9,13 +9,14 @@
 
 #include "hunting_monitor/linear.h"
 #include "biquad.h"
+#include "hunting_monitor/criteria.h"
 
-enum { BAND_SECTIONS = 4, PEAK_SECTIONS = 3 };
+enum { BAND_SECTIONS = 4 };
 
 struct hm_estimator_s {
   hm_estimator_config cfg;
   hm_biquad band[BAND_SECTIONS];    /* HP4 + LP4 */
-  hm_biquad peak[PEAK_SECTIONS];    /* HP2 + LP4 */
+  hm_criteria criteria;           /* the standard criteria on the same samples */
   /* sample history */
   int have_sample;
   double t_last, t_start;        /* last accepted sample, start of the current run (after a gap) */
@@ -26,13 +27,6 @@ struct hm_estimator_s {
   double sum_sq, count;          /* running sum of x^2 and number of samples since the restart */
   size_t cross_cap, cross_head, cross_n;
   int armed;
-  /* sliding r.m.s. over distance: ring of (x^2, metres) */
-  double *sq, *dist;
-  size_t ring_cap, ring_head, ring_n, since_resum;
-  double ring_sum, ring_dist;
-  /* peaks */
-  double p_prev, half_peak;
-  unsigned consecutive;
   /* speed */
   int have_speed;
   double speed_kmh, t_speed;
@@ -149,9 +143,6 @@ static void restart_signal(hm_estimator e) {
   e->band[1] = hm_biquad_design(1, c->band_low_hz, HM_BUTTERWORTH_Q4[1], fs);
   e->band[2] = hm_biquad_design(0, c->band_high_hz, HM_BUTTERWORTH_Q4[0], fs);
   e->band[3] = hm_biquad_design(0, c->band_high_hz, HM_BUTTERWORTH_Q4[1], fs);
-  e->peak[0] = hm_biquad_design(1, c->peaks_band_low_hz, HM_BUTTERWORTH_Q2, fs);
-  e->peak[1] = hm_biquad_design(0, c->peaks_band_high_hz, HM_BUTTERWORTH_Q4[0], fs);
-  e->peak[2] = hm_biquad_design(0, c->peaks_band_high_hz, HM_BUTTERWORTH_Q4[1], fs);
   e->have_sample = 0;
   e->x_prev = 0.0;
   e->ms = 0.0;
@@ -160,11 +151,7 @@ static void restart_signal(hm_estimator e) {
   e->trk_f = e->trk_amp = 0.0;
   e->trk_spread = 1.0;
   e->armed = 0;
-  e->ring_head = e->ring_n = e->since_resum = 0;
-  e->ring_sum = e->ring_dist = 0.0;
-  e->p_prev = 0.0;
-  e->half_peak = 0.0;
-  e->consecutive = 0;
+  hm_criteria_restart(e->criteria, fs);
   e->blk_n = 0.0;
   e->off_blocks = 0;
 }
@@ -204,15 +191,12 @@ hm_status hm_estimator_create(const hm_estimator_config *cfg, hm_estimator *out,
   e->cfg = *cfg;
   /* crossings in one tracking time at the top of the band, with room to spare */
   e->cross_cap = (size_t)ceil(cfg->band_high_hz * cfg->tracking_time_s * 2.0) + 8;
-  /* the r.m.s. window holds rms_window_m down to 30 km/h (and at least one second) */
-  /* sized for the highest supported rate, since the filters follow the measured rate */
-  e->ring_cap = (size_t)ceil(5000.0 * fmax(cfg->rms_window_m / (30.0 / 3.6), 1.0)) + 1;
   e->cross = malloc(e->cross_cap * sizeof(double));
   e->cross_sum = malloc(e->cross_cap * sizeof(double));
   e->cross_count = malloc(e->cross_cap * sizeof(double));
-  e->sq = malloc(e->ring_cap * sizeof(double));
-  e->dist = malloc(e->ring_cap * sizeof(double));
-  if (!e->cross || !e->cross_sum || !e->cross_count || !e->sq || !e->dist) {
+  const hm_criteria_config cc = {cfg->rms_window_m,       cfg->rms_limit_mps2,     cfg->peaks_band_low_hz,
+                                 cfg->peaks_band_high_hz, cfg->peaks_limit_mps2, cfg->peaks_count};
+  if (!e->cross || !e->cross_sum || !e->cross_count || hm_criteria_create(&cc, &e->criteria) != HM_OK) {
     hm_estimator_destroy(e);
     return HM_ENOMEM;
   }
@@ -232,8 +216,7 @@ void hm_estimator_destroy(hm_estimator e) {
   free(e->cross);
   free(e->cross_sum);
   free(e->cross_count);
-  free(e->sq);
-  free(e->dist);
+  hm_criteria_destroy(e->criteria);
   free(e);
 }
 
@@ -308,50 +291,6 @@ static double tracked(const hm_estimator e, double *spread, double *amp) {
   return f;
 }
 
-/* sliding sum over the last rms_window_m of track */
-static void rms_push(hm_estimator e, double x2, double metres) {
-  if (e->ring_n == e->ring_cap) { /* full: drop the oldest */
-    const size_t old = (e->ring_head + e->ring_cap - e->ring_n) % e->ring_cap;
-    e->ring_sum -= e->sq[old];
-    e->ring_dist -= e->dist[old];
-    --e->ring_n;
-  }
-  e->sq[e->ring_head] = x2;
-  e->dist[e->ring_head] = metres;
-  e->ring_head = (e->ring_head + 1) % e->ring_cap;
-  ++e->ring_n;
-  e->ring_sum += x2;
-  e->ring_dist += metres;
-  while (e->ring_n > 1) { /* keep just enough samples to cover the window */
-    const size_t old = (e->ring_head + e->ring_cap - e->ring_n) % e->ring_cap;
-    if (e->ring_dist - e->dist[old] < e->cfg.rms_window_m) break;
-    e->ring_sum -= e->sq[old];
-    e->ring_dist -= e->dist[old];
-    --e->ring_n;
-  }
-  if (++e->since_resum >= e->ring_cap) { /* bound the rounding drift of the running sums */
-    e->ring_sum = e->ring_dist = 0.0;
-    for (size_t k = 0; k < e->ring_n; ++k) {
-      const size_t i = (e->ring_head + e->ring_cap - e->ring_n + k) % e->ring_cap;
-      e->ring_sum += e->sq[i];
-      e->ring_dist += e->dist[i];
-    }
-    e->since_resum = 0;
-  }
-}
-
-static void peaks_push(hm_estimator e, double p) {
-  if ((p >= 0.0) != (e->p_prev >= 0.0)) { /* a half cycle ended */
-    if (e->half_peak >= e->cfg.peaks_limit_mps2)
-      ++e->consecutive;
-    else
-      e->consecutive = 0;
-    e->half_peak = 0.0;
-  }
-  e->half_peak = fmax(e->half_peak, fabs(p));
-  e->p_prev = p;
-}
-
 hm_status hm_estimator_push_accel(hm_estimator e, double t, double a) {
   if (!e) return HM_EINVAL;
   if (!isfinite(t) || !isfinite(a)) {
@@ -378,8 +317,6 @@ hm_status hm_estimator_push_accel(hm_estimator e, double t, double a) {
   e->counters.n_samples++;
   double x = a;
   for (int k = 0; k < BAND_SECTIONS; ++k) x = hm_biquad_step(&e->band[k], x);
-  double p = a;
-  for (int k = 0; k < PEAK_SECTIONS; ++k) p = hm_biquad_step(&e->peak[k], p);
   /* mean square with time constant tracking_time / 2 */
   e->ms += (1.0 - exp(-dt / (0.5 * e->cfg.tracking_time_s))) * (x * x - e->ms);
   /* up-crossings, armed once the signal went below -10% of the amplitude */
@@ -399,8 +336,7 @@ hm_status hm_estimator_push_accel(hm_estimator e, double t, double a) {
   }
   e->x_prev = x;
   const int speed_ok = e->have_speed && t - e->t_speed <= e->cfg.speed_timeout_s;
-  rms_push(e, x * x, speed_ok ? hm_mps_from_kmh(e->speed_kmh) * dt : 0.0);
-  peaks_push(e, p);
+  hm_criteria_push(e->criteria, x, a, speed_ok ? hm_mps_from_kmh(e->speed_kmh) * dt : 0.0);
   return HM_OK;
 }
 
@@ -445,10 +381,12 @@ void hm_estimator_read(const hm_estimator e, double now, hm_estimate *out) {
   r.period_spread = r.oscillation_valid ? spread : 1.0;
   const double w = 2.0 * HM_PI * r.frequency_hz;
   r.amplitude_displacement_m = r.oscillation_valid ? r.amplitude_accel_mps2 / (w * w) : 0.0;
-  r.rms_mps2 = e->ring_n ? sqrt(fmax(e->ring_sum, 0.0) / (double)e->ring_n) : 0.0;
-  r.rms_window_complete = e->ring_dist >= c->rms_window_m * (1.0 - 1e-9); /* rounding of the running sum */
-  r.rms_exceeded = r.rms_window_complete && r.rms_mps2 >= c->rms_limit_mps2;
-  r.consecutive_peaks = e->consecutive;
-  r.peaks_exceeded = e->consecutive >= c->peaks_count;
+  hm_criteria_state k;
+  hm_criteria_read(e->criteria, &k);
+  r.rms_mps2 = k.rms_mps2;
+  r.rms_window_complete = k.rms_window_complete;
+  r.rms_exceeded = k.rms_exceeded;
+  r.consecutive_peaks = k.consecutive_peaks;
+  r.peaks_exceeded = k.peaks_exceeded;
   *out = r;
 }
