@@ -78,10 +78,6 @@ typedef struct {
 
 const char *hm_cycle_event_name(hm_cycle_event_kind kind); /* "LPC", "BPC", "PD", "NS" */
 
-/* Whether lambda(y) is even (every Gaussian term has a mirror term with equal amplitude and width) so that
- * the model is odd-symmetric; relative tolerance tol on the term values. */
-int hm_conicity_is_even(const hm_conicity *con, double tol);
-
 /*
  * Continue the family of cycles born at the Hopf point `hopf` (found with hm_hopf_find for opt->param; the
  * other parameters are those of veh and speed_kmh). The first cycle is solved at max|y| = amp_start_m, the

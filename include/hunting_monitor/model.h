@@ -95,6 +95,10 @@ hm_status hm_vehicle_set_conicity_at_zero(hm_vehicle *veh, double conicity0);
 /* lambda(y) and dlambda/dy [1/m]; either output may be NULL. */
 void hm_conicity_eval(const hm_conicity *con, double y_m, double *lambda, double *dlambda_dy);
 
+/* Whether lambda(y) is even (every Gaussian term has a mirror term with equal amplitude and width) so that
+ * the model is odd-symmetric; relative tolerance tol on the term values. */
+int hm_conicity_is_even(const hm_conicity *con, double tol);
+
 /* Derivatives d^j lambda / dy^j at y for j = 0..kmax (kmax <= 8) into d[0..kmax], by Hermite polynomials:
  * d^j/dy^j exp(-u^2) = (-1)^j H_j(u) exp(-u^2) / c^j with u = (y - b)/c. */
 void hm_conicity_derivatives(const hm_conicity *con, double y_m, int kmax, double *d);

@@ -39,22 +39,6 @@ void hm_cycle_options_default(hm_cycle_options *opt, hm_param p) {
   opt->use_symmetry = 1;
 }
 
-int hm_conicity_is_even(const hm_conicity *con, double tol) {
-  for (size_t i = 0; i < con->n_terms; ++i) {
-    const hm_gaussian *g = &con->terms[i];
-    if (g->center_m == 0.0) continue;
-    int mirrored = 0;
-    for (size_t j = 0; j < con->n_terms && !mirrored; ++j) {
-      const hm_gaussian *h = &con->terms[j];
-      mirrored = fabs(h->center_m + g->center_m) <= tol * fabs(g->center_m) &&
-                 fabs(h->amplitude - g->amplitude) <= tol * fabs(g->amplitude) &&
-                 fabs(h->width_m - g->width_m) <= tol * g->width_m;
-    }
-    if (!mirrored) return 0;
-  }
-  return 1;
-}
-
 /* The 5x5 Newton matrix [scaled Jacobian; row] in column-major order. */
 static void newton_matrix(const hm_sh *c, const hm_shot *s, const double *row, double *A) {
   for (int i = 0; i < NX; ++i)

@@ -294,3 +294,19 @@ hm_status hm_model_jacobian(double t, const double *x, double *jac, void *model)
   memcpy(jac, J, sizeof J);
   return HM_OK;
 }
+
+int hm_conicity_is_even(const hm_conicity *con, double tol) {
+  for (size_t i = 0; i < con->n_terms; ++i) {
+    const hm_gaussian *g = &con->terms[i];
+    if (g->center_m == 0.0) continue;
+    int mirrored = 0;
+    for (size_t j = 0; j < con->n_terms && !mirrored; ++j) {
+      const hm_gaussian *h = &con->terms[j];
+      mirrored = fabs(h->center_m + g->center_m) <= tol * fabs(g->center_m) &&
+                 fabs(h->amplitude - g->amplitude) <= tol * fabs(g->amplitude) &&
+                 fabs(h->width_m - g->width_m) <= tol * g->width_m;
+    }
+    if (!mirrored) return 0;
+  }
+  return 1;
+}

@@ -164,6 +164,30 @@ static void set_conicity_at_zero(void) {
   HM_CHECK(hm_vehicle_set_conicity_at_zero(&v, NAN) == HM_EDOMAIN, "NaN conicity");
 }
 
+/* Evenness of lambda(y) (the model's odd symmetry, which shooting uses to integrate half a period): the default
+ * and the raw three-Gaussian fit of MODEL.md section 3 against lambda evaluated at +-y (the definition), and a
+ * term moved off its mirror. */
+static void conicity_evenness_matches_the_definition(void) {
+  hm_vehicle v;
+  hm_vehicle_default(&v);
+  double worst = 0.0;
+  for (int i = 1; i <= 200; ++i) {
+    double lp, lm;
+    hm_conicity_eval(&v.conicity, 1e-4 * i, &lp, NULL);
+    hm_conicity_eval(&v.conicity, -1e-4 * i, &lm, NULL);
+    worst = fmax(worst, fabs(lp - lm));
+  }
+  HM_CHECK(worst < 1e-15 && hm_conicity_is_even(&v.conicity, 1e-12), "default: even %d, worst |l(y) - l(-y)| %g",
+           hm_conicity_is_even(&v.conicity, 1e-12), worst);
+  hm_conicity raw = {0.0, 3, {{0.7099, 0.009884, 0.001472}, {0.6979, -0.009873, 0.001444}, {2.319e14, -18.3, 3.095}}};
+  double lp, lm;
+  hm_conicity_eval(&raw, 0.01, &lp, NULL);
+  hm_conicity_eval(&raw, -0.01, &lm, NULL);
+  HM_CHECK(fabs(lp - lm) > 1e-3 && !hm_conicity_is_even(&raw, 1e-12), "raw fit: l(0.01) %g, l(-0.01) %g", lp, lm);
+  v.conicity.terms[1].center_m *= 1.01;
+  HM_CHECK(!hm_conicity_is_even(&v.conicity, 1e-12), "a moved term");
+}
+
 int main(void) {
   HM_RUN(defaults_are_the_published_parameters);
   HM_RUN(flange_force_closed_form);
@@ -172,5 +196,6 @@ int main(void) {
   HM_RUN(validation_names_the_bad_field);
   HM_RUN(model_rejects_bad_speed_and_state);
   HM_RUN(set_conicity_at_zero);
+  HM_RUN(conicity_evenness_matches_the_definition);
   HM_TEST_EXIT();
 }
