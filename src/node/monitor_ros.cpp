@@ -237,9 +237,9 @@ void MonitorRos::onTimer(const ros::TimerEvent&) {
   m.hopf_speed_kmh = s.boundaries_valid ? finite(b.hopf_speed_kmh) : 0.0;
   m.hopf_speed_kmh_low = s.boundaries_valid ? finite(s.hopf_low_kmh) : 0.0;
   m.hopf_speed_kmh_high = s.boundaries_valid ? finite(s.hopf_high_kmh) : 0.0;
-  m.lower_fold_speed_kmh = s.boundaries_valid ? finite(b.lowest_cycle_speed_kmh) : 0.0;
+  m.lowest_cycle_speed_kmh = s.boundaries_valid ? finite(b.lowest_cycle_speed_kmh) : 0.0;
   m.margin_to_hopf_kmh = s.boundaries_valid ? finite(s.margin_hopf_kmh) : 0.0;
-  m.margin_to_lower_fold_kmh = s.boundaries_valid ? finite(s.margin_lowest_cycle_kmh) : 0.0;
+  m.margin_to_lowest_cycle_kmh = s.boundaries_valid ? finite(s.margin_lowest_cycle_kmh) : 0.0;
   m.amplitude_accel_mps2 = finite(e.amplitude_accel_mps2);
   m.amplitude_displacement_m = finite(e.amplitude_displacement_m);
   m.frequency_hz = finite(e.frequency_hz);

@@ -65,7 +65,7 @@ class Replay(unittest.TestCase):
         # WATCH from 30 km/h below the Hopf interval (517.618 km/h -+ the shipped table's stated 0.48 km/h), WARN
         # from 10 km/h below it, ALARM at the latest just past the Hopf speed; the levels only go up along the ramp
         self.assertEqual(levels[0], "OK")
-        self.assertTrue(any(m.level == HuntingStatus.LEVEL_OK and m.margin_to_lower_fold_kmh < 0 for m in seq))
+        self.assertTrue(any(m.level == HuntingStatus.LEVEL_OK and m.margin_to_lowest_cycle_kmh < 0 for m in seq))
         first_watch = next(m for m in seq if m.level == HuntingStatus.LEVEL_WATCH)
         self.assertAlmostEqual(first_watch.speed_kmh, 517.618 - 0.483 - 30.0, delta=1.0)
         first_warn = next(m for m in seq if m.level == HuntingStatus.LEVEL_WARN)
@@ -89,7 +89,7 @@ class Replay(unittest.TestCase):
             agree_level += LEVELS[m.level] == r["level"]
             if r["margin_hopf_kmh"] is not None and m.boundaries_valid:
                 agree_margin += abs(m.margin_to_hopf_kmh - r["margin_hopf_kmh"]) < 2.0 and \
-                    abs(m.lower_fold_speed_kmh - r["lowest_cycle_kmh"]) < 2.0
+                    abs(m.lowest_cycle_speed_kmh - r["lowest_cycle_kmh"]) < 2.0
         self.assertGreater(n, 400, "too few matched status messages")
         self.assertGreaterEqual(agree_level / n, 0.95, f"levels agree in {agree_level}/{n}")
         self.assertGreaterEqual(agree_margin / n, 0.90, f"margins agree in {agree_margin}/{n}")

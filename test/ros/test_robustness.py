@@ -59,7 +59,7 @@ class Robustness(unittest.TestCase):
         else:
             self.assertEqual(m.level, HuntingStatus.LEVEL_OK, (m.level, m.reason))
             self.assertEqual(m.reason_code, 4, m.reason)  # normal running: the bistable band is in the fields
-            self.assertLess(m.margin_to_lower_fold_kmh, 0.0)
+            self.assertLess(m.margin_to_lowest_cycle_kmh, 0.0)
 
     def latest(self, after):
         with self.lock:
