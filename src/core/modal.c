@@ -9,8 +9,8 @@
 #include "biquad.h"
 #include "fft.h"
 
-enum { NP = 6 }; /* sigma, w0, c0, c1, c2, ln N */
-enum { P_SIGMA, P_W0, P_C0, P_C1, P_C2, P_LN };
+enum { NP = 7 }; /* sigma, w0, c0, c1, c2, c3, ln N */
+enum { P_SIGMA, P_W0, P_C0, P_C1, P_C2, P_C3, P_LN };
 
 struct hm_modal_s {
   hm_modal_config cfg;
@@ -166,30 +166,31 @@ int hm_modal_fit_due(const hm_modal m) {
   return m && (double)m->n_in >= m->cfg.min_window_s * m->fd && (double)m->since_fit >= m->cfg.fit_interval_s * m->fd;
 }
 
-/* ln S_k and its gradient for bin k. */
-static double log_spectrum(const double *th, double w, double u, double *grad) {
+/* S_k (its gradient of ln S_k in grad, if not NULL) for bin k. */
+static double spectrum(const double *th, double w, double u, double *grad) {
   const double sg = th[P_SIGMA], w0 = th[P_W0];
   const double re = sg * sg + w0 * w0 - w * w, d = re * re + 4.0 * sg * sg * w * w;
-  const double b = exp(th[P_C0] + th[P_C1] * u + th[P_C2] * u * u), n = exp(th[P_LN]);
+  const double b = exp(th[P_C0] + u * (th[P_C1] + u * (th[P_C2] + u * th[P_C3]))), n = exp(th[P_LN]);
   const double mode = b / d, s = mode + n;
   if (grad) {
-    const double dd_sg = 4.0 * re * sg + 8.0 * sg * w * w, dd_w0 = 4.0 * re * w0;
-    grad[P_SIGMA] = -mode / d * dd_sg / s;
-    grad[P_W0] = -mode / d * dd_w0 / s;
-    grad[P_C0] = mode / s;
-    grad[P_C1] = mode * u / s;
-    grad[P_C2] = mode * u * u / s;
+    const double dd_sg = 4.0 * re * sg + 8.0 * sg * w * w, dd_w0 = 4.0 * re * w0, ms = mode / s;
+    grad[P_SIGMA] = -ms / d * dd_sg;
+    grad[P_W0] = -ms / d * dd_w0;
+    grad[P_C0] = ms;
+    grad[P_C1] = ms * u;
+    grad[P_C2] = ms * u * u;
+    grad[P_C3] = ms * u * u * u;
     grad[P_LN] = n / s;
   }
-  return log(s);
+  return s;
 }
 
 /* Negative Whittle log-likelihood over the band's nb bins. */
 static double objective(const hm_modal m, size_t nb, const double *th) {
   double l = 0.0;
   for (size_t k = 0; k < nb; ++k) {
-    const double ls = log_spectrum(th, m->w[k], m->u[k], NULL);
-    l += ls + m->pgram[k] * exp(-ls);
+    const double sk = spectrum(th, m->w[k], m->u[k], NULL);
+    l += log(sk) + m->pgram[k] / sk;
   }
   return l;
 }
@@ -226,8 +227,7 @@ static void scoring_system(const hm_modal m, size_t nb, const double *th, double
   memset(g, 0, sizeof(double) * NP);
   for (size_t k = 0; k < nb; ++k) {
     double j[NP];
-    const double ls = log_spectrum(th, m->w[k], m->u[k], j);
-    const double r = m->pgram[k] * exp(-ls) - 1.0;
+    const double r = m->pgram[k] / spectrum(th, m->w[k], m->u[k], j) - 1.0;
     for (int a = 0; a < NP; ++a) {
       g[a] += j[a] * r;
       for (int b = 0; b <= a; ++b) f[a][b] += j[a] * j[b];
@@ -295,7 +295,7 @@ static void cold_start(const hm_modal m, size_t nb, double sigma0, double *th) {
   th[P_SIGMA] = sigma0;
   th[P_W0] = w0;
   th[P_C0] = log(fmax(best - 0.5 * lo, 1e-300) * 4.0 * sigma0 * sigma0 * w0 * w0);
-  th[P_C1] = th[P_C2] = 0.0;
+  th[P_C1] = th[P_C2] = th[P_C3] = 0.0;
   th[P_LN] = log(fmax(0.5 * lo, 1e-300));
 }
 
@@ -380,7 +380,8 @@ hm_status hm_modal_fit(hm_modal m, double max_window_s, hm_mode_estimate *out) {
   r.damping_ratio = -sg / mag;
   /* d zeta / d sigma = w0^2 / |s|^3 (w0's share of the error is second order for light damping) */
   r.damping_ratio_se = r.decay_rate_se_1_s * w0 * w0 / (mag * mag * mag);
-  const double peak = exp(best[P_C0] + best[P_C1] * log(w0 / w_ref) + best[P_C2] * pow(log(w0 / w_ref), 2)) /
+  const double uw = log(w0 / w_ref);
+  const double peak = exp(best[P_C0] + best[P_C1] * uw + best[P_C2] * uw * uw + best[P_C3] * uw * uw * uw) /
                       (4.0 * sg * sg * w0 * w0);
   r.peak_to_mean = peak; /* the periodogram is scaled to mean 1 over the band */
   r.iterations = iters;

@@ -189,6 +189,7 @@ hm_status hm_monitor_push_accel(hm_monitor m, double t, double a) {
     restart_stream(m);
   }
   m->t_last = t;
+  if (!isfinite(m->t_chunk)) m->t_chunk = t; /* the first chunk starts with the stream */
   if (m->have_speed) {
     m->cur.min = fmin(m->cur.min, m->speed_kmh);
     m->cur.max = fmax(m->cur.max, m->speed_kmh);
