@@ -89,7 +89,14 @@ void hm_margin_reset(hm_margin m);
 hm_status hm_margin_add_window(hm_margin m, double t_end_s, double speed_kmh, double speed_spread_kmh,
                                const hm_mode_estimate *mode, hm_window_verdict *verdict);
 
-/* The estimate as of now_s (windows older than memory_s left out). */
+/* The current steady stretch as a provisional window: checked like a window, counted by hm_margin_read, replaced by
+ * the next call, stored by hm_margin_commit_pending (when the stretch ends) and dropped by hm_margin_add_window. A
+ * stretch thus contributes while it lasts, and once as one long window (not as overlapping or short pieces). */
+hm_status hm_margin_set_pending(hm_margin m, double t_end_s, double speed_kmh, double speed_spread_kmh,
+                                const hm_mode_estimate *mode, hm_window_verdict *verdict);
+void hm_margin_commit_pending(hm_margin m);
+
+/* The estimate as of now_s (windows older than memory_s left out; the pending one counted). */
 void hm_margin_read(const hm_margin m, double now_s, hm_margin_estimate *out);
 
 /* The closed-form Hopf speed [km/h] of the vehicle at a conicity; HM_TABLE_MAX_SPEED_KMH-like large value (1e4)

@@ -7,8 +7,8 @@
  *    the decimated rate: anti-aliasing) and decimated to about decimated_rate_hz; the window's periodogram
  *    I_k (rectangular window, zero-padded to a power of two) is taken over [band_low_hz, band_high_hz].
  *  - The spectral model is one lightly damped mode over a smooth background plus white sensor noise:
- *        S(w) = exp(c0 + c1 u + c2 u^2) / |(iw - s)(iw - conj s)|^2 + N,   s = sigma + i w0,  u = ln(w / w_ref).
- *    The mode is the hunting pair of the linear model (its poles are s); the background exp(quadratic in ln w)
+ *        S(w) = exp(c0 + c1 u + c2 u^2 + c3 u^3) / |(iw - s)(iw - conj s)|^2 + N,  s = sigma + i w0, u = ln(w / w_ref).
+ *    The mode is the hunting pair of the linear model (its poles are s); the background exp(cubic in ln w)
  *    takes what is smooth across the band: the second, heavily damped pair of the same model (damping ratio about
  *    0.6 at the same frequency), the s^2 of acceleration, the filters and the colour of the track excitation, which
  *    differs between tracks and is not known.
@@ -21,7 +21,8 @@
  * Why not an AR model of the acceleration: the second mode at the same frequency and the double zero at DC of
  * acceleration are not all-pole; on the exact spectrum of the default vehicle at 420 km/h, AR(10)/AR(20) fits of the
  * decimated acceleration give a decay rate of -3.8 1/s where the model's eigenvalue is -6.33 (40% off), the peak fit
- * -6.1..-6.8 depending on the excitation's colour. Bias and spread measured on both simulators: see README.
+ * -6.1..-6.8 depending on the excitation's colour. A quadratic background left the decay rate 10% small in magnitude
+ * at 420-460 km/h on the independent simulator, the cubic 5%. Bias and spread on both simulators: see README.
  *
  * Cost: per sample three biquads and a decimation counter; per fit (every fit_interval_s) one FFT of the window
  * (4096 points at 100 Hz and 40 s) and about 5-20 scoring steps over the band's bins. No allocation after create.

@@ -8,7 +8,8 @@
  *  - the conicity fallback: the alarm's conicity_fallback, or the vehicle's own lambda(0) when that is 0 (so a
  *    fitted or worn vehicle never falls back to the default vehicle's conicity);
  *  - the identification follows the estimator: restarted after a gap, redesigned for a measured sample rate.
- * Windows of the identification are offered to the margin with the speed's mean and range over the window.
+ * At a steady speed the identification's windows go to the margin with the speed's mean and range: the current
+ * stretch provisionally (from min_window_s), committed in full windows (window_s) and when the stretch ends.
  * No allocation after create.
  */
 #ifndef HUNTING_MONITOR_MONITOR_H
@@ -61,7 +62,8 @@ typedef struct hm_monitor_s *hm_monitor;
 hm_status hm_monitor_create(const hm_monitor_config *cfg, const hm_vehicle *veh, hm_table table, hm_monitor *out,
                             char *why, size_t why_len);
 void hm_monitor_destroy(hm_monitor m);
-/* Forget the stream (time jumped): estimator, identification and alarm state; the margin's windows stay. */
+/* Forget the stream (time jumped): estimator, identification, margin (its windows' times are on the old time line)
+ * and alarm state. */
 void hm_monitor_reset(hm_monitor m);
 
 /* One acceleration sample [m/s^2] at t_s; the estimator's status (rejected samples are counted there). */

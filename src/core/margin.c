@@ -25,6 +25,8 @@ struct hm_margin_s {
   window w[HM_MARGIN_MAX_WINDOWS];
   size_t head, n;
   double last_end_s;
+  window pending;               /* the current steady stretch, not yet committed */
+  int have_pending;
 };
 
 void hm_margin_config_default(hm_margin_config *c) {
@@ -80,6 +82,7 @@ void hm_margin_reset(hm_margin m) {
   if (!m) return;
   m->head = m->n = 0;
   m->last_end_s = -INFINITY;
+  m->have_pending = 0;
 }
 
 double hm_margin_hopf_kmh(const hm_margin m, double conicity) {
@@ -88,14 +91,14 @@ double hm_margin_hopf_kmh(const hm_margin m, double conicity) {
   return fmin(hm_kmh_from_mps(v_mps), NO_HOPF_KMH);
 }
 
-hm_status hm_margin_add_window(hm_margin m, double t_end, double speed_kmh, double spread_kmh,
-                               const hm_mode_estimate *mode, hm_window_verdict *verdict) {
-  if (!m || !mode || !verdict || !isfinite(t_end) || !isfinite(speed_kmh) || !isfinite(spread_kmh)) return HM_EINVAL;
+/* A window's checks and inversion into *w; the verdict says whether it can be used. */
+static hm_window_verdict prepare(const hm_margin m, double t_end, double speed_kmh, double spread_kmh,
+                                 const hm_mode_estimate *mode, window *w) {
   const hm_margin_config *c = &m->cfg;
-  if (!mode->valid) return *verdict = HM_WINDOW_MODE_INVALID, HM_OK;
-  if (spread_kmh > c->max_speed_spread_kmh) return *verdict = HM_WINDOW_SPEED_VARIED, HM_OK;
-  if (speed_kmh < c->min_speed_kmh) return *verdict = HM_WINDOW_TOO_SLOW, HM_OK;
-  if (t_end - mode->window_s < m->last_end_s - 1e-9) return *verdict = HM_WINDOW_OVERLAPS, HM_OK;
+  if (!mode->valid) return HM_WINDOW_MODE_INVALID;
+  if (spread_kmh > c->max_speed_spread_kmh) return HM_WINDOW_SPEED_VARIED;
+  if (speed_kmh < c->min_speed_kmh) return HM_WINDOW_TOO_SLOW;
+  if (t_end - mode->window_s < m->last_end_s - 1e-9) return HM_WINDOW_OVERLAPS;
   /* statistical and systematic errors of the measured mode */
   const double sys_sigma = c->decay_rate_model_error * fabs(mode->decay_rate_1_s);
   const double sys_f = c->frequency_model_error * mode->frequency_hz;
@@ -103,26 +106,53 @@ hm_status hm_margin_add_window(hm_margin m, double t_end, double speed_kmh, doub
   hm_conicity_inversion inv;
   if (hm_conicity_from_mode(&m->coef, speed_kmh, mode->decay_rate_1_s, e_sigma, mode->frequency_hz, e_f, 1e-9, 60,
                             &inv) != HM_OK)
-    return *verdict = HM_WINDOW_NO_INVERSION, HM_OK;
+    return HM_WINDOW_NO_INVERSION;
   /* the systematic part of the conicity's error: the weighted sensitivities applied to the systematic errors */
   const double js = inv.dsigma_dconicity / (e_sigma * e_sigma), jf = inv.dfrequency_dconicity / (e_f * e_f);
   const double info = inv.dsigma_dconicity * js + inv.dfrequency_dconicity * jf;
   const double lambda_sys = hypot(js * sys_sigma, jf * sys_f) / info;
+  w->t_end_s = t_end;
+  w->speed_kmh = speed_kmh;
+  w->sigma = mode->decay_rate_1_s;
+  w->sigma_stat = mode->decay_rate_se_1_s;
+  w->lambda = inv.conicity;
+  w->lambda_se = inv.conicity_se;
+  w->lambda_sys = fmin(lambda_sys, inv.conicity_se);
+  w->lambda_stat = sqrt(fmax(inv.conicity_se * inv.conicity_se - w->lambda_sys * w->lambda_sys, 0.0));
+  return HM_WINDOW_USED;
+}
+
+hm_status hm_margin_add_window(hm_margin m, double t_end, double speed_kmh, double spread_kmh,
+                               const hm_mode_estimate *mode, hm_window_verdict *verdict) {
+  if (!m || !mode || !verdict || !isfinite(t_end) || !isfinite(speed_kmh) || !isfinite(spread_kmh)) return HM_EINVAL;
   window w;
-  w.t_end_s = t_end;
-  w.speed_kmh = speed_kmh;
-  w.sigma = mode->decay_rate_1_s;
-  w.sigma_stat = mode->decay_rate_se_1_s;
-  w.lambda = inv.conicity;
-  w.lambda_se = inv.conicity_se;
-  w.lambda_sys = fmin(lambda_sys, inv.conicity_se);
-  w.lambda_stat = sqrt(fmax(inv.conicity_se * inv.conicity_se - w.lambda_sys * w.lambda_sys, 0.0));
+  *verdict = prepare(m, t_end, speed_kmh, spread_kmh, mode, &w);
+  if (*verdict != HM_WINDOW_USED) return HM_OK;
   m->w[m->head] = w;
   m->head = (m->head + 1) % HM_MARGIN_MAX_WINDOWS;
   if (m->n < HM_MARGIN_MAX_WINDOWS) ++m->n;
   m->last_end_s = t_end;
-  *verdict = HM_WINDOW_USED;
+  m->have_pending = 0;
   return HM_OK;
+}
+
+hm_status hm_margin_set_pending(hm_margin m, double t_end, double speed_kmh, double spread_kmh,
+                                const hm_mode_estimate *mode, hm_window_verdict *verdict) {
+  if (!m || !mode || !verdict || !isfinite(t_end) || !isfinite(speed_kmh) || !isfinite(spread_kmh)) return HM_EINVAL;
+  window w;
+  *verdict = prepare(m, t_end, speed_kmh, spread_kmh, mode, &w);
+  m->have_pending = *verdict == HM_WINDOW_USED;
+  if (m->have_pending) m->pending = w;
+  return HM_OK;
+}
+
+void hm_margin_commit_pending(hm_margin m) {
+  if (!m || !m->have_pending) return;
+  m->w[m->head] = m->pending;
+  m->head = (m->head + 1) % HM_MARGIN_MAX_WINDOWS;
+  if (m->n < HM_MARGIN_MAX_WINDOWS) ++m->n;
+  m->last_end_s = m->pending.t_end_s;
+  m->have_pending = 0;
 }
 
 /* (a): inverse-variance mean of the windows' conicities; systematic errors do not average out. */
@@ -198,6 +228,11 @@ void hm_margin_read(const hm_margin m, double now, hm_margin_estimate *out) {
     ws[n++] = w;
     r.speed_min_kmh = fmin(r.speed_min_kmh, w->speed_kmh);
     r.speed_max_kmh = fmax(r.speed_max_kmh, w->speed_kmh);
+  }
+  if (m->have_pending && n < HM_MARGIN_MAX_WINDOWS) { /* the current stretch counts, provisionally */
+    ws[n++] = &m->pending;
+    r.speed_min_kmh = fmin(r.speed_min_kmh, m->pending.speed_kmh);
+    r.speed_max_kmh = fmax(r.speed_max_kmh, m->pending.speed_kmh);
   }
   r.n_windows = (unsigned)n;
   if (n == 0) r.speed_min_kmh = r.speed_max_kmh = 0.0;

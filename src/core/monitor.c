@@ -32,6 +32,8 @@ struct hm_monitor_s {
   hm_mode_estimate mode;
   double mode_speed, mode_spread;
   hm_window_verdict verdict;
+  double committed_until;        /* end of the last window committed to the margin (or the stream's restart) */
+  double pending_until;          /* end of the margin's provisional window */
 };
 
 void hm_monitor_config_default(hm_monitor_config *c) {
@@ -74,6 +76,8 @@ static void restart_stream(hm_monitor m) {
   m->n_chunks = m->chunk_head = 0;
   chunk_clear(&m->cur);
   m->t_chunk = NAN;
+  if (m->margin) hm_margin_commit_pending(m->margin); /* a gap ends the steady stretch */
+  m->committed_until = -INFINITY;
 }
 
 hm_status hm_monitor_create(const hm_monitor_config *cfg, const hm_vehicle *veh, hm_table table, hm_monitor *out,
@@ -133,13 +137,16 @@ void hm_monitor_reset(hm_monitor m) {
   m->restarts = hm_estimator_restarts(m->est, &m->rate_hz);
   m->have_speed = 0;
   memset(&m->mode, 0, sizeof m->mode);
+  hm_margin_reset(m->margin); /* its windows' times are on the old time line */
   restart_stream(m);
   hm_alarm_reset(m->alarm);
 }
 
-/* A fit of the identification over the steady part of the window (the newest stretch whose speed varied by at most
- * the margin's max_speed_spread_kmh, up to window_s), offered to the margin when it is at least min_window_s long;
- * the whole window (for display) otherwise. */
+/* A fit of the identification. At a steady speed (the newest stretch whose speed varied by at most the margin's
+ * max_speed_spread_kmh) the part of the stretch not yet given to the margin is fitted, up to window_s: a full
+ * window is committed to the margin, a shorter one (from min_window_s) is its provisional window, committed when the
+ * stretch ends. So a stretch contributes while it lasts and once in long, non-overlapping windows. Otherwise the
+ * whole window is fitted for display only. */
 static void fit(hm_monitor m, double t) {
   m->cur.duration_s = isfinite(m->t_chunk) ? t - m->t_chunk : 0.0;
   m->chunks[m->chunk_head] = m->cur;
@@ -147,9 +154,10 @@ static void fit(hm_monitor m, double t) {
   if (m->n_chunks < m->n_chunks_cap) ++m->n_chunks;
   chunk_clear(&m->cur);
   m->t_chunk = t;
+  const hm_modal_config *mc = &m->cfg.modal;
   speed_chunk steady;
   chunk_clear(&steady);
-  for (size_t k = 0; k < m->n_chunks && steady.duration_s < m->cfg.modal.window_s; ++k) {
+  for (size_t k = 0; k < m->n_chunks && steady.duration_s < mc->window_s; ++k) {
     const speed_chunk *c = &m->chunks[(m->chunk_head + m->n_chunks_cap - 1 - k) % m->n_chunks_cap];
     if (c->n == 0.0 || fmax(steady.max, c->max) - fmin(steady.min, c->min) > m->cfg.margin.max_speed_spread_kmh)
       break;
@@ -159,17 +167,28 @@ static void fit(hm_monitor m, double t) {
     steady.n += c->n;
     steady.duration_s += c->duration_s;
   }
-  const int is_steady = steady.duration_s >= m->cfg.modal.min_window_s;
+  const int is_steady = steady.duration_s >= mc->min_window_s;
+  if (!is_steady) hm_margin_commit_pending(m->margin); /* the stretch ended */
+  /* the part of the stretch after the last committed window */
+  const double fresh = is_steady ? fmin(steady.duration_s, t - m->committed_until) : 0.0;
+  const int for_margin = fresh >= mc->min_window_s;
   hm_mode_estimate e;
-  if (hm_modal_fit(m->modal, is_steady ? steady.duration_s : m->cfg.modal.window_s, &e) != HM_OK) {
+  if (hm_modal_fit(m->modal, for_margin ? fresh : mc->window_s, &e) != HM_OK) {
     m->mode.valid = 0;
     return;
   }
   m->mode = e;
   m->mode_speed = steady.n > 0.0 ? steady.sum / steady.n : m->speed_kmh;
   m->mode_spread = is_steady ? steady.max - steady.min : INFINITY;
-  m->verdict = HM_WINDOW_SPEED_VARIED;
-  if (is_steady) hm_margin_add_window(m->margin, t, m->mode_speed, m->mode_spread, &e, &m->verdict);
+  m->verdict = is_steady ? HM_WINDOW_OVERLAPS : HM_WINDOW_SPEED_VARIED;
+  if (!for_margin) return;
+  if (e.window_s >= mc->window_s * (1.0 - 1e-9)) {
+    hm_margin_add_window(m->margin, t, m->mode_speed, m->mode_spread, &e, &m->verdict);
+    if (m->verdict == HM_WINDOW_USED) m->committed_until = t;
+  } else {
+    hm_margin_set_pending(m->margin, t, m->mode_speed, m->mode_spread, &e, &m->verdict);
+    if (m->verdict == HM_WINDOW_USED) m->pending_until = t;
+  }
 }
 
 hm_status hm_monitor_push_accel(hm_monitor m, double t, double a) {

@@ -152,10 +152,40 @@ static void refusals_and_mismatch(void) {
   hm_margin_destroy(m);
 }
 
+/* The provisional window of a steady stretch counts while it lasts, is replaced by the next, and is stored once when
+ * the stretch ends; a window overlapping it later is refused. */
+static void pending_window_of_a_stretch(void) {
+  hm_margin_config c;
+  hm_margin_config_default(&c);
+  hm_margin m = NULL;
+  hm_margin_create(&c, &vehicle, &m, NULL, 0);
+  hm_window_verdict v;
+  hm_mode_estimate e = mode_at(0.16, 440.0, 0.3, 0.05);
+  e.window_s = 20.0;
+  hm_margin_set_pending(m, 20.0, 440.0, 1.0, &e, &v);
+  hm_margin_estimate g;
+  hm_margin_read(m, 20.0, &g);
+  HM_CHECK(v == HM_WINDOW_USED && g.n_windows == 1 && g.conicity_valid, "pending counted: %u", g.n_windows);
+  HM_CHECK_DELTA(g.conicity, 0.16, 1e-6, "conicity from the pending window");
+  e.window_s = 30.0;
+  hm_margin_set_pending(m, 30.0, 440.0, 1.0, &e, &v); /* the stretch grew: replaced, not added */
+  hm_margin_read(m, 30.0, &g);
+  HM_CHECK(g.n_windows == 1, "replaced: %u", g.n_windows);
+  hm_margin_commit_pending(m);
+  hm_margin_commit_pending(m); /* nothing left to commit */
+  hm_margin_read(m, 31.0, &g);
+  HM_CHECK(g.n_windows == 1, "committed once: %u", g.n_windows);
+  e.window_s = 20.0;
+  hm_margin_set_pending(m, 40.0, 440.0, 1.0, &e, &v); /* starts at 20 s, before the committed end (30 s) */
+  HM_CHECK(v == HM_WINDOW_OVERLAPS, "overlap refused: %d", v);
+  hm_margin_destroy(m);
+}
+
 int main(void) {
   hm_vehicle_default(&vehicle);
   HM_RUN(inversion_recovers_the_conicity);
   HM_RUN(both_ways_agree_on_a_consistent_vehicle);
   HM_RUN(refusals_and_mismatch);
+  HM_RUN(pending_window_of_a_stretch);
   HM_TEST_EXIT();
 }
