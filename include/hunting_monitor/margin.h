@@ -10,7 +10,7 @@
  * (a) Model-based. Each window's (decay rate, frequency, speed) is inverted jointly for the equivalent conicity
  *     (inversion.h). The errors passed to the inversion are the fit's statistical ones and a systematic part:
  *     frequency_model_error (relative: how far the model's hunting frequency may be from the vehicle's) and
- *     decay_rate_model_error (relative: the identification's bias, about 10% on both simulators, README). The
+ *     decay_rate_model_error (relative: the identification's bias, up to 5-10% on the two simulators, README). The
  *     windows' conicities are averaged with inverse-variance weights; the statistical part of the error shrinks
  *     with the number of windows, the systematic part does not. The Hopf speed and its interval are the closed-form
  *     critical speeds (linear.h) at lambda and at lambda -+ interval_z standard errors.
