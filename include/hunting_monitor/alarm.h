@@ -22,7 +22,7 @@
  *            model (the model-based and model-free Hopf speeds disagree), or the sensor at another rate than
  *            configured. No action; have the wheels' conicity or the sensor checked at the next stop.
  *   OK       normal running. The bistable band (a large disturbance could start flange-contact hunting above the
- *            lowest cycle speed, MODEL.md section 7) is stated in the status fields, not as a level: on good track
+ *            lowest cycle speed, docs/MODEL.md section 7) is stated in the status fields, not as a level: on good track
  *            at service speed it is permanent and a level that never changes tells a driver nothing.
  * Thresholds of the current (or a higher) level are relaxed by the hysteresis (hysteresis_kmh on speeds,
  * hysteresis_amplitude_fraction of the edge on amplitudes), a higher level is taken at once, and a lower one only

@@ -1,7 +1,7 @@
 /*
  * hunting_monitor - the vehicle configuration file (YAML, parsed with libyaml).
  *
- *   vehicle:                        # MODEL.md section 2 (SI units except stiffnesses in MN/m)
+ *   vehicle:                        # docs/MODEL.md section 2 (SI units except stiffnesses in MN/m)
  *     name: crh380_default          # optional
  *     mass_kg: 1869
  *     yaw_inertia_kg_m2: 910

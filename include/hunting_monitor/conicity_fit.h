@@ -1,7 +1,7 @@
 /*
  * hunting_monitor - fit of the equivalent conicity lambda(y) to measured (y, lambda) pairs.
  *
- * Model: lambda(y) = constant + sum of n_terms Gaussians a_i exp(-((y - b_i)/c_i)^2) (MODEL.md section 3), or
+ * Model: lambda(y) = constant + sum of n_terms Gaussians a_i exp(-((y - b_i)/c_i)^2) (docs/MODEL.md section 3), or
  * its symmetric form (pairs at +-b sharing a and c; an odd count adds one term centred at 0), with the constant
  * free or fixed at 0 (MATLAB's gauss3 has none). Widths are kept positive by fitting log c.
  *

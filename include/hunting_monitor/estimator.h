@@ -1,5 +1,5 @@
 /*
- * hunting_monitor - streaming estimator of the dominant lateral oscillation and the standard criteria (MODEL.md
+ * hunting_monitor - streaming estimator of the dominant lateral oscillation and the standard criteria (docs/MODEL.md
  * section 5).
  *
  * Input: lateral acceleration samples [m/s^2] with timestamps [s] at a nominal rate of 100 Hz..5 kHz, and speed

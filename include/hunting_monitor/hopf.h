@@ -1,5 +1,5 @@
 /*
- * hunting_monitor - Hopf bifurcations of the origin and their Lyapunov coefficients (MODEL.md section 4).
+ * hunting_monitor - Hopf bifurcations of the origin and their Lyapunov coefficients (docs/MODEL.md section 4).
  *
  * Convention (MATCONT's): A q = i w q, A^T p = -i w p, <q, q> = 1, <p, q> = 1 with <u, v> = conj(u)^T v;
  * B, C, D, E the 2nd..5th derivative multilinear forms of the right-hand side at the origin;

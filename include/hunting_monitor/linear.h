@@ -1,5 +1,5 @@
 /*
- * hunting_monitor - linear stability of the origin (MODEL.md section 2).
+ * hunting_monitor - linear stability of the origin (docs/MODEL.md section 2).
  *
  * The characteristic polynomial of the linear model factorises as
  *   (s^2 + (c1/v) s + a)(s^2 + (c2/v) s + b) + g e lambda

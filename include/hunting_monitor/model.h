@@ -1,5 +1,5 @@
 /*
- * hunting_monitor - the nonlinear wheelset model of MODEL.md sections 2 and 3.
+ * hunting_monitor - the nonlinear wheelset model of docs/MODEL.md sections 2 and 3.
  *
  * States (SI): x[0] = y lateral displacement [m], x[1] = dy/dt [m/s],
  *              x[2] = psi yaw angle [rad],       x[3] = dpsi/dt [rad/s].
@@ -57,7 +57,7 @@ typedef struct {
   double flange_alpha2_n_m5;      /* alpha2 of F_T [N/m^5] */
 } hm_vehicle;
 
-/* Coefficients of the linear part of the model, derived from an hm_vehicle (MODEL.md section 2). */
+/* Coefficients of the linear part of the model, derived from an hm_vehicle (docs/MODEL.md section 2). */
 typedef struct {
   double k_lat_s2;     /* (Kx/m)(l0/l1 - 1) + Ky/m [1/s^2] */
   double k_yaw_s2;     /* Kx d1^2 / I [1/s^2] */
@@ -75,7 +75,7 @@ typedef struct {
   double speed_mps;    /* v [m/s], > 0 */
 } hm_model;
 
-/* The shipped CRH380-class defaults of MODEL.md sections 2 and 3 (Kx = Ky = 8.96 MN/m, simplified fit). */
+/* The shipped CRH380-class defaults of docs/MODEL.md sections 2 and 3 (Kx = Ky = 8.96 MN/m, simplified fit). */
 void hm_vehicle_default(hm_vehicle *veh);
 
 /*

@@ -1,4 +1,4 @@
-/* The wheelset model: MODEL.md sections 2 and 3. */
+/* The wheelset model: docs/MODEL.md sections 2 and 3. */
 #include "hunting_monitor/model.h"
 
 #include <math.h>
@@ -17,7 +17,7 @@ void hm_vehicle_default(hm_vehicle *veh) {
   veh->spring_ratio = 1.351186;
   veh->stiffness_long_n_m = 8.96e6;
   veh->stiffness_lat_n_m = 8.96e6;
-  /* Simplified symmetric fit of the measured conicity (MODEL.md section 3). */
+  /* Simplified symmetric fit of the measured conicity (docs/MODEL.md section 3). */
   veh->conicity.constant = 0.1358;
   veh->conicity.n_terms = 2;
   veh->conicity.terms[0] = (hm_gaussian){0.7, 0.01, 0.00145};
