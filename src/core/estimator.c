@@ -176,9 +176,7 @@ static void measure_rate(hm_estimator e, double t) {
   if (e->off_blocks >= RATE_BLOCKS_TO_REDESIGN && rate_supported(&e->cfg, e->measured_rate_hz)) {
     e->design_rate_hz = e->measured_rate_hz;
     e->counters.n_rate_changes++;
-    const double t_keep = e->t_last;
     restart_signal(e); /* the filters' state belongs to the old design */
-    e->t_last = t_keep;
   }
 }
 

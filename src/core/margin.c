@@ -122,17 +122,22 @@ static hm_window_verdict prepare(const hm_margin m, double t_end, double speed_k
   return HM_WINDOW_USED;
 }
 
+/* Keep a window (the ring drops the oldest beyond its size); any provisional one is superseded. */
+static void store(hm_margin m, const window *w) {
+  m->w[m->head] = *w;
+  m->head = (m->head + 1) % HM_MARGIN_MAX_WINDOWS;
+  if (m->n < HM_MARGIN_MAX_WINDOWS) ++m->n;
+  m->last_end_s = w->t_end_s;
+  m->have_pending = 0;
+}
+
 hm_status hm_margin_add_window(hm_margin m, double t_end, double speed_kmh, double spread_kmh,
                                const hm_mode_estimate *mode, hm_window_verdict *verdict) {
   if (!m || !mode || !verdict || !isfinite(t_end) || !isfinite(speed_kmh) || !isfinite(spread_kmh)) return HM_EINVAL;
   window w;
   *verdict = prepare(m, t_end, speed_kmh, spread_kmh, mode, &w);
   if (*verdict != HM_WINDOW_USED) return HM_OK;
-  m->w[m->head] = w;
-  m->head = (m->head + 1) % HM_MARGIN_MAX_WINDOWS;
-  if (m->n < HM_MARGIN_MAX_WINDOWS) ++m->n;
-  m->last_end_s = t_end;
-  m->have_pending = 0;
+  store(m, &w);
   return HM_OK;
 }
 
@@ -148,11 +153,7 @@ hm_status hm_margin_set_pending(hm_margin m, double t_end, double speed_kmh, dou
 
 void hm_margin_commit_pending(hm_margin m) {
   if (!m || !m->have_pending) return;
-  m->w[m->head] = m->pending;
-  m->head = (m->head + 1) % HM_MARGIN_MAX_WINDOWS;
-  if (m->n < HM_MARGIN_MAX_WINDOWS) ++m->n;
-  m->last_end_s = m->pending.t_end_s;
-  m->have_pending = 0;
+  store(m, &m->pending);
 }
 
 /* (a): inverse-variance mean of the windows' conicities; systematic errors do not average out. */

@@ -28,12 +28,10 @@ struct hm_monitor_s {
   size_t n_chunks_cap, chunk_head, n_chunks;
   speed_chunk cur;
   double t_chunk;                /* start of the current chunk */
-  double t_last;
   hm_mode_estimate mode;
   double mode_speed, mode_spread;
   hm_window_verdict verdict;
   double committed_until;        /* end of the last window committed to the margin (or the stream's restart) */
-  double pending_until;          /* end of the margin's provisional window */
 };
 
 void hm_monitor_config_default(hm_monitor_config *c) {
@@ -187,7 +185,6 @@ static void fit(hm_monitor m, double t) {
     if (m->verdict == HM_WINDOW_USED) m->committed_until = t;
   } else {
     hm_margin_set_pending(m->margin, t, m->mode_speed, m->mode_spread, &e, &m->verdict);
-    if (m->verdict == HM_WINDOW_USED) m->pending_until = t;
   }
 }
 
@@ -207,7 +204,6 @@ hm_status hm_monitor_push_accel(hm_monitor m, double t, double a) {
     }
     restart_stream(m);
   }
-  m->t_last = t;
   if (!isfinite(m->t_chunk)) m->t_chunk = t; /* the first chunk starts with the stream */
   if (m->have_speed) {
     m->cur.min = fmin(m->cur.min, m->speed_kmh);
