@@ -30,23 +30,70 @@
 extern "C" {
 #endif
 
+/* Integration of the shooting system. */
+typedef struct {
+  double rtol, atol;        /* Dormand-Prince 5(4) tolerances of the state and its variations */
+  int use_symmetry;         /* 1: half-period shooting when the vehicle is odd-symmetric; 0: never */
+} hm_shooting_options;
+
+/*
+ * Pseudo-arclength continuation, shared by cycle families and LPC curves: predictor along the unit tangent,
+ * Newton's corrector orthogonal to it (an update above 50 scaled units counts as divergence), then step control.
+ * A step is rejected and retried at half the length (down to ds_min) when the corrector fails, lands farther
+ * than max(|ds|, jump_floor) from the predictor (a jump to another branch) or turns the tangent by more than
+ * acos(min_tangent_cos). After an accepted step ds grows by grow_factor (up to ds_max) when Newton needed at most
+ * fast_newton_iters iterations and shrinks by shrink_factor when it needed slow_newton_iters or more.
+ */
+typedef struct {
+  double ds_init, ds_min, ds_max; /* arclength steps (scaled units, see above) */
+  size_t max_steps;         /* step attempts, accepted or rejected (per direction for LPC curves) */
+  double min_tangent_cos;   /* cycles 0.95; LPC curves 0.9 (their fold row makes the tangent noisier) */
+  int fast_newton_iters;    /* cycles 2; LPC curves 3 (their fold-test row is a chord: one more iteration) */
+  int slow_newton_iters;    /* cycles 5; LPC curves 6 */
+  double grow_factor;       /* 1.5 */
+  double shrink_factor;     /* 0.7 */
+  double jump_floor;        /* 0.05 scaled units */
+  double newton_tol;        /* Newton stops when the scaled update is below this (max norm): 1e-9 */
+  size_t newton_max_iter;   /* 8 */
+  double locate_tol;        /* events are located to this arclength (scaled units): 1e-9 */
+} hm_cont_options;
+
+/* The cycle-family defaults above (ds 0.2 in 0.0001..5, 2000 steps, 0.95, 2/5, 1.5/0.7, 0.05, 1e-9, 8, 1e-9). */
+void hm_cont_options_default(hm_cont_options *opt);
+/* 1 if the settings are usable (positive steps in order, 0 < min_tangent_cos < 1, fast < slow, ...). */
+int hm_cont_options_valid(const hm_cont_options *opt);
+
+/* Why a continuation ended. */
+typedef enum {
+  HM_CONT_STEP_LIMIT = 0,   /* max_steps attempts made */
+  HM_CONT_PARAM_RANGE,      /* the (first) parameter left [p_min, p_max] */
+  HM_CONT_PARAM2_RANGE,     /* LPC curves: the second parameter left its range */
+  HM_CONT_AMP_MAX,          /* the cycle's max|y| exceeded amp_max_m */
+  HM_CONT_AMP_MIN,          /* LPC curves: the fold cycle shrank below amp_min_m (towards a GH point) */
+  HM_CONT_MIN_STEP          /* no step converged even at ds_min */
+} hm_cont_stop;
+
+const char *hm_cont_stop_name(hm_cont_stop stop); /* a short English phrase */
+
+typedef struct {
+  hm_cont_stop stop;
+  size_t steps;             /* accepted steps */
+  size_t rejected;          /* rejected step attempts */
+  size_t newton_iterations; /* Newton iterations of the run, event location included */
+  size_t shots;             /* integrations of the shooting system (LPC: the fold test's gradient included) */
+} hm_cont_stats;
+
 typedef struct {
   hm_param param;           /* continuation parameter */
   double p_min, p_max;      /* stop when the parameter leaves [p_min, p_max] (user units) */
   double amp_max_m;         /* stop when max|y| exceeds this [m] */
   double amp_start_m;       /* max|y| of the first cycle computed near the Hopf point [m] */
-  double ds_init, ds_min, ds_max; /* arclength steps (scaled units, see above) */
-  size_t max_steps;         /* continuation step limit */
-  double rtol, atol;        /* shooting integration tolerances */
-  double newton_tol;        /* Newton stops when the scaled update is below this (max norm) */
-  size_t newton_max_iter;
-  double locate_tol;        /* events are located to this arclength (scaled units) */
-  int use_symmetry;         /* 1: half-period shooting when the vehicle is odd-symmetric; 0: never */
+  hm_shooting_options shoot;
+  hm_cont_options cont;
 } hm_cycle_options;
 
-/* Defaults for parameter p: a wide range, 20 mm amplitude limit, ds 0.2 (0.0001..5), 2000 steps,
- * rtol 1e-9, atol 1e-12 (fold speeds then agree with rtol 1e-12 to 1e-6 km/h), Newton 1e-9 (8 iterations),
- * location to 1e-9, symmetry on. */
+/* Defaults for parameter p: a wide range, 20 mm amplitude limit, hm_cont_options_default, rtol 1e-9,
+ * atol 1e-12 (fold speeds then agree with rtol 1e-12 to 1e-6 km/h), symmetry on. */
 void hm_cycle_options_default(hm_cycle_options *opt, hm_param p);
 
 typedef struct {
@@ -87,17 +134,17 @@ const char *hm_cycle_event_name(hm_cycle_event_kind kind); /* "LPC", "BPC", "PD"
  * product of (mu - 1) over the non-trivial real multipliers otherwise; PD: of det(M + I); NS: change in the
  * number of complex multipliers outside the unit circle) and located by Brent's method along the arclength.
  * Writes up to max_points points and max_events events; *n_points and *n_events count those written.
- * *stop_reason (may be NULL) receives a static string saying why the continuation ended.
+ * *stats (may be NULL) receives why the continuation ended and its step, Newton and shot counts.
  * Returns HM_OK if at least two points were computed; otherwise the error that prevented it.
  */
 hm_status hm_cycles_continue(const hm_vehicle *veh, double speed_kmh, const hm_hopf_point *hopf,
                              const hm_cycle_options *opt, hm_cycle_point *points, size_t max_points,
                              size_t *n_points, hm_cycle_event *events, size_t max_events, size_t *n_events,
-                             const char **stop_reason);
+                             hm_cont_stats *stats);
 
 /*
  * One cycle at fixed parameter value p near the guess (x0 with dy/dt = 0, period) by Newton's method on the
- * shooting equations (opt gives tolerances and symmetry). HM_ENOCONV if Newton does not converge.
+ * shooting equations (opt->shoot and opt->cont's Newton settings). HM_ENOCONV if Newton does not converge.
  */
 hm_status hm_cycle_solve(const hm_vehicle *veh, double speed_kmh, const hm_cycle_options *opt, double p,
                          const double x0_guess[4], double period_guess_s, hm_cycle_point *cycle);
@@ -108,12 +155,12 @@ typedef struct {
   hm_param param2;          /* the second parameter (the first is the cycle options' param) */
   double p2_min, p2_max;    /* stop when it leaves this range */
   double amp_min_m;         /* stop when the fold cycle shrinks below this (the curve ends at a GH point) */
-  double ds_init, ds_min, ds_max; /* arclength steps (scaled units) */
-  size_t max_steps;         /* per direction */
   double fd_step;           /* forward-difference step of the fold test's gradient (scaled units) */
+  hm_cont_options cont;     /* step control (the shooting settings are the cycle options') */
 } hm_lpc_options;
 
-/* Defaults: p2 in [0.1, 100] (or conicity [0.001, 2]), amp_min 0.5 mm, ds 0.1..5, 400 steps, fd 1e-6. */
+/* Defaults: p2 in [0.1, 100] (or conicity [0.001, 2]), amp_min 0.5 mm, fd 1e-6, and the continuation defaults
+ * but ds 0.1..5, 400 steps per direction, min_tangent_cos 0.9 and Newton thresholds 3/6. */
 void hm_lpc_options_default(hm_lpc_options *opt, hm_param param2);
 
 typedef struct {
@@ -130,13 +177,13 @@ typedef struct {
  * p2; equations: the shooting equations, the fold condition det(d res / d(y0, psi0, dpsi0, T)) = 0 (its
  * gradient by forward differences), and the pseudo-arclength condition. Cusp points (CPC) are where dp2/ds
  * changes sign along the curve, located by Brent's method. points (ordered along the curve) and cusps receive
- * up to max_points / max_cusps entries; counts in *n_points, *n_cusps. stop_reasons[0..1] (may be NULL) say why
- * each direction ended.
+ * up to max_points / max_cusps entries; counts in *n_points, *n_cusps. stats[0..1] (may be NULL) say why each
+ * direction (backward, forward) ended and what it cost; the correction onto the first fold counts in stats[0].
  */
 hm_status hm_lpc_curve(const hm_vehicle *veh, double speed_kmh, const hm_cycle_options *copt,
                        const hm_lpc_options *lopt, const hm_cycle_event *fold, hm_lpc_point *points,
                        size_t max_points, size_t *n_points, hm_lpc_point *cusps, size_t max_cusps,
-                       size_t *n_cusps, const char *stop_reasons[2]);
+                       size_t *n_cusps, hm_cont_stats stats[2]);
 
 #ifdef __cplusplus
 }

@@ -137,7 +137,7 @@ typedef struct {
   size_t n_points;
   hm_cycle_event events[MAX_EVENTS];
   size_t n_events;
-  const char *stop_reason;
+  hm_cont_stats stats;
 } family;
 
 static int run_family(const hm_vehicle *veh, double speed, const hm_hopf_point *hopf, const hm_cycle_options *o,
@@ -145,7 +145,7 @@ static int run_family(const hm_vehicle *veh, double speed, const hm_hopf_point *
   fam->points = malloc(MAX_BRANCH * sizeof *fam->points);
   if (!fam->points) return cli_fail_status("cycles", HM_ENOMEM);
   hm_status st = hm_cycles_continue(veh, speed, hopf, o, fam->points, MAX_BRANCH, &fam->n_points, fam->events,
-                                    MAX_EVENTS, &fam->n_events, &fam->stop_reason);
+                                    MAX_EVENTS, &fam->n_events, &fam->stats);
   if (st != HM_OK) return cli_fail_status("continuation of cycles from the Hopf point", st);
   return 0;
 }
@@ -216,6 +216,17 @@ static void write_branch_csv(FILE *f, const family *fam, const char *pname) {
   }
 }
 
+/* What a continuation cost: accepted and rejected steps, Newton iterations, integrations of the shooting system. */
+static void write_cont_stats(json_writer *w, const char *key, const hm_cont_stats *s) {
+  jw_object(w, key);
+  jw_string(w, "stop_reason", hm_cont_stop_name(s->stop));
+  jw_number(w, "steps", (double)s->steps);
+  jw_number(w, "rejected_steps", (double)s->rejected);
+  jw_number(w, "newton_iterations", (double)s->newton_iterations);
+  jw_number(w, "shots", (double)s->shots);
+  jw_end_object(w);
+}
+
 static void write_family_json(FILE *f, const hm_hopf_point *hopf, const family *fam, const family *fine,
                               hm_param p) {
   const char *pname = hm_param_name(p);
@@ -231,7 +242,8 @@ static void write_family_json(FILE *f, const hm_hopf_point *hopf, const family *
   double lowest = INFINITY;
   for (size_t i = 0; i < fam->n_points; ++i) lowest = fmin(lowest, fam->points[i].param);
   jw_number(&w, p == HM_PARAM_SPEED ? "lowest_cycle_v_kmh" : "lowest_cycle_param", lowest);
-  jw_string(&w, "stop_reason", fam->stop_reason);
+  jw_string(&w, "stop_reason", hm_cont_stop_name(fam->stats.stop));
+  write_cont_stats(&w, "continuation", &fam->stats);
   if (fine) write_refinement(&w, fam, fine, pname);
   jw_array(&w, "branch");
   for (size_t i = 0; i < fam->n_points; ++i) {
@@ -261,13 +273,13 @@ static int cycle_options(const cli_args *a, hm_param p, hm_cycle_options *o) {
   default_range(p, &o->p_min, &o->p_max);
   const char *lo_key = p == HM_PARAM_SPEED ? "v-min" : "from", *hi_key = p == HM_PARAM_SPEED ? "v-max" : "to";
   if (cli_number(a, lo_key, &o->p_min) || cli_number(a, hi_key, &o->p_max) ||
-      cli_number(a, "amp-max", &o->amp_max_m) || cli_number(a, "ds-max", &o->ds_max) ||
-      cli_number(a, "rtol", &o->rtol))
+      cli_number(a, "amp-max", &o->amp_max_m) || cli_number(a, "ds-max", &o->cont.ds_max) ||
+      cli_number(a, "rtol", &o->shoot.rtol))
     return 1;
-  if (!(o->p_max > o->p_min) || !(o->amp_max_m > 2.0 * o->amp_start_m) || !(o->ds_max >= o->ds_init) ||
-      !(o->rtol > 0.0 && o->rtol < 1e-3)) {
+  if (!(o->p_max > o->p_min) || !(o->amp_max_m > 2.0 * o->amp_start_m) || !(o->cont.ds_max >= o->cont.ds_init) ||
+      !(o->shoot.rtol > 0.0 && o->shoot.rtol < 1e-3)) {
     fprintf(stderr, "hunting cycles: need --%s < --%s, --amp-max > %g m, --ds-max >= %g, 0 < --rtol < 1e-3\n",
-            lo_key, hi_key, 2.0 * o->amp_start_m, o->ds_init);
+            lo_key, hi_key, 2.0 * o->amp_start_m, o->cont.ds_init);
     return 1;
   }
   return 0;
@@ -289,11 +301,11 @@ int cmd_cycles(const cli_args *a) {
   int rc = run_family(&veh, speed, &hopf, &o, &fam);
   if (rc == 0 && cli_has(a, "refine")) {
     hm_cycle_options of = o;
-    of.rtol *= 1e-2;
-    of.atol *= 1e-2;
-    of.ds_max *= 0.25;
-    of.ds_init *= 0.25;
-    of.max_steps *= 4;
+    of.shoot.rtol *= 1e-2;
+    of.shoot.atol *= 1e-2;
+    of.cont.ds_max *= 0.25;
+    of.cont.ds_init *= 0.25;
+    of.cont.max_steps *= 4;
     rc = run_family(&veh, speed, &hopf, &of, &fine);
   }
   const char *path = cli_value(a, "out");
@@ -501,9 +513,9 @@ int cmd_lpc_curve(const cli_args *a) {
     const hm_cycle_event *fold = &fam.events[i];
     if (fold->kind != HM_CYCLE_LPC || on_curve(all, used, start, fold)) continue;
     size_t np = 0, nc = 0;
-    const char *reasons[2];
+    hm_cont_stats stats[2];
     hm_status st = hm_lpc_curve(&veh, speed, &o, &lo, fold, all + used, MAX_LPC - used, &np,
-                                cusps + n_cusps_all, 32 - n_cusps_all, &nc, reasons);
+                                cusps + n_cusps_all, 32 - n_cusps_all, &nc, stats);
     if (st != HM_OK) {
       rc = cli_fail_status("LPC curve", st);
       break;
@@ -512,8 +524,12 @@ int cmd_lpc_curve(const cli_args *a) {
     jw_number(&w, "from_fold_v_kmh", fold->point.param);
     jw_number(&w, "from_fold_amplitude_m", fold->point.amp_y_m);
     jw_array(&w, "stop_reasons");
-    jw_string(&w, NULL, reasons[0]);
-    jw_string(&w, NULL, reasons[1]);
+    jw_string(&w, NULL, hm_cont_stop_name(stats[0].stop));
+    jw_string(&w, NULL, hm_cont_stop_name(stats[1].stop));
+    jw_end_array(&w);
+    jw_array(&w, "continuation");
+    write_cont_stats(&w, NULL, &stats[0]);
+    write_cont_stats(&w, NULL, &stats[1]);
     jw_end_array(&w);
     jw_array(&w, "points");
     for (size_t k = 0; k < np; ++k) write_lpc_point(&w, &all[used + k], p2name);

@@ -7,8 +7,7 @@
 
 #include "hunting_monitor/integrate.h"
 #include "hunting_monitor/linear.h"
-#include "hunting_monitor/roots.h"
-#include "lapack.h"
+#include "continuation.h"
 #include "shooting.h"
 
 const char *hm_cycle_event_name(hm_cycle_event_kind kind) {
@@ -27,91 +26,32 @@ void hm_cycle_options_default(hm_cycle_options *opt, hm_param p) {
   opt->p_max = p == HM_PARAM_SPEED ? 2000.0 : p == HM_PARAM_CONICITY ? 2.0 : 100.0;
   opt->amp_max_m = 0.020;
   opt->amp_start_m = 2e-4;
-  opt->ds_init = 0.2;
-  opt->ds_min = 1e-4;
-  opt->ds_max = 5.0;
-  opt->max_steps = 2000;
-  opt->rtol = 1e-9;
-  opt->atol = 1e-12;
-  opt->newton_tol = 1e-9;
-  opt->newton_max_iter = 8;
-  opt->locate_tol = 1e-9;
-  opt->use_symmetry = 1;
-}
-
-/* The 5x5 Newton matrix [scaled Jacobian; row] in column-major order. */
-static void newton_matrix(const hm_sh *c, const hm_shot *s, const double *row, double *A) {
-  for (int i = 0; i < NX; ++i)
-    for (int j = 0; j < NU; ++j) A[i + NU * j] = s->jac[NW * i + j] * c->sc[j] / hm_sh_res_scale[i];
-  for (int j = 0; j < NU; ++j) A[NX + NU * j] = row[j];
-}
-
-/*
- * Newton on the shooting equations plus one scalar equation row . (u / sc) = target. u in/out (unscaled).
- * Converged when the scaled update is below newton_tol; *iters gets the iteration count; s receives the
- * last evaluation (at the iterate before the final, converged update).
- */
-static hm_status newton(hm_sh *c, double *u, const double *row, double target, hm_shot *s, int *iters) {
-  double w[NW] = {0, 0, 0, 0, 0, 0};
-  memcpy(w, u, NU * sizeof(double));
-  for (size_t it = 0; it < c->opt->newton_max_iter; ++it) {
-    hm_status st = hm_sh_shoot(c, w, s);
-    if (st != HM_OK) return st;
-    double A[NU * NU], b[NU];
-    newton_matrix(c, s, row, A);
-    double rowdot = 0.0;
-    for (int j = 0; j < NU; ++j) rowdot += row[j] * w[j] / c->sc[j];
-    for (int i = 0; i < NX; ++i) b[i] = -s->res[i] / hm_sh_res_scale[i];
-    b[NX] = -(rowdot - target);
-    int ipiv[NU], info = 0;
-    const int n = NU, one = 1;
-    dgesv_(&n, &one, A, &n, ipiv, b, &n, &info);
-    if (info != 0) return HM_ELAPACK;
-    double dmax = 0.0;
-    for (int j = 0; j < NU; ++j) {
-      w[j] += b[j] * c->sc[j];
-      dmax = fmax(dmax, fabs(b[j]));
-    }
-    if (!isfinite(dmax) || dmax > 50.0) return HM_ENOCONV; /* diverging */
-    if (dmax <= c->opt->newton_tol) {
-      memcpy(u, w, NU * sizeof(double));
-      if (iters) *iters = (int)it + 1;
-      return HM_OK;
-    }
-  }
-  return HM_ENOCONV;
-}
-
-/* Unit tangent (scaled) of the branch: the null vector of the scaled Jacobian, oriented along ref. */
-static hm_status tangent_of(const hm_sh *c, const hm_shot *s, const double *ref, double *t) {
-  double A[NU * NU], b[NU] = {0, 0, 0, 0, 1.0};
-  newton_matrix(c, s, ref, A);
-  int ipiv[NU], info = 0;
-  const int n = NU, one = 1;
-  dgesv_(&n, &one, A, &n, ipiv, b, &n, &info);
-  if (info != 0) return HM_ELAPACK;
-  double norm = 0.0, dot = 0.0;
-  for (int j = 0; j < NU; ++j) norm += b[j] * b[j];
-  norm = sqrt(norm);
-  if (!(norm > 0.0) || !isfinite(norm)) return HM_ENONFINITE;
-  for (int j = 0; j < NU; ++j) {
-    t[j] = b[j] / norm;
-    dot += t[j] * ref[j];
-  }
-  if (dot < 0.0)
-    for (int j = 0; j < NU; ++j) t[j] = -t[j];
-  return HM_OK;
+  opt->shoot.rtol = 1e-9;
+  opt->shoot.atol = 1e-12;
+  opt->shoot.use_symmetry = 1;
+  hm_cont_options_default(&opt->cont);
 }
 
 /* ---- multipliers and test functions ---- */
 
 typedef struct {
+  hm_cont_point head;    /* unknowns and unit tangent (scaled) */
   hm_cycle_point pub;
-  double t[NU];          /* unit tangent (scaled) */
-  double u[NU];
   double bpc, pd;        /* test functions */
   int ns_count;          /* complex non-trivial multipliers outside the unit circle */
 } node;
+
+/* The continuation problem: the shooting equations in the unknowns u = (y0, psi0, dpsi0, T, p). */
+typedef struct {
+  hm_sh sh;
+  hm_shot last;          /* the latest evaluation */
+  hm_cont_problem prob;
+  const hm_cycle_options *opt;
+  hm_cycle_point *points;
+  size_t max_points, np;
+  hm_cycle_event *events;
+  size_t max_events, ne;
+} cyc;
 
 static hm_status fill_node(const hm_sh *c, const hm_shot *s, const double *u, const double *t, node *nd) {
   double re[NX], im[NX];
@@ -177,8 +117,8 @@ static hm_status fill_node(const hm_sh *c, const hm_shot *s, const double *u, co
   out.pub.n_unstable = n_unstable;
   out.pub.stable = n_unstable == 0;
   out.pub.dparam_ds = t[4];
-  memcpy(out.t, t, sizeof out.t);
-  memcpy(out.u, u, sizeof out.u);
+  memcpy(out.head.t, t, NU * sizeof(double));
+  memcpy(out.head.u, u, NU * sizeof(double));
   out.bpc = bpc;
   out.pd = pd;
   out.ns_count = ns_count;
@@ -186,37 +126,24 @@ static hm_status fill_node(const hm_sh *c, const hm_shot *s, const double *u, co
   return HM_OK;
 }
 
-/* Corrector from node a along its tangent at arclength sigma; fills nd. */
-static hm_status step_from(hm_sh *c, const node *a, double sigma, node *nd, int *iters) {
-  double u[NU], row[NU], target = 0.0;
-  for (int j = 0; j < NU; ++j) {
-    u[j] = a->u[j] + sigma * a->t[j] * c->sc[j];
-    row[j] = a->t[j];
-    target += a->t[j] * u[j] / c->sc[j];
-  }
-  double pred[NU];
-  memcpy(pred, u, sizeof pred);
-  hm_shot s;
-  hm_status st = newton(c, u, row, target, &s, iters);
+static hm_status cyc_eval(void *ctx, const double *u, int iter, double *res, double *jac) {
+  (void)iter;
+  cyc *y = (cyc *)ctx;
+  hm_status st = hm_sh_shoot(&y->sh, u, &y->last);
   if (st != HM_OK) return st;
-  /* A corrector that lands farther from the predictor than the step itself has jumped to another branch
-   * (typically the trivial one, x0 = 0, which solves the shooting equations for every T and p). */
-  double dist = 0.0;
-  for (int j = 0; j < NU; ++j) dist += (u[j] - pred[j]) * (u[j] - pred[j]) / (c->sc[j] * c->sc[j]);
-  if (sqrt(dist) > fmax(fabs(sigma), 0.05)) return HM_ENOCONV;
-  double t[NU];
-  if ((st = tangent_of(c, &s, a->t, t)) != HM_OK) return st;
-  return fill_node(c, &s, u, t, nd);
+  for (int i = 0; i < NX; ++i) {
+    res[i] = y->last.res[i] / hm_sh_res_scale[i];
+    for (int j = 0; j < NU; ++j) jac[NU * i + j] = y->last.jac[NW * i + j] * y->sh.sc[j] / hm_sh_res_scale[i];
+  }
+  return HM_OK;
+}
+
+static hm_status cyc_finish(void *ctx, const double *u, const double *t, void *nd) {
+  cyc *y = (cyc *)ctx;
+  return fill_node(&y->sh, &y->last, u, t, (node *)nd);
 }
 
 /* ---- event location ---- */
-
-typedef struct {
-  hm_sh *c;
-  const node *a;
-  hm_cycle_event_kind kind;
-  node last;
-} locate_ctx;
 
 static double test_value(const node *nd, hm_cycle_event_kind kind) {
   switch (kind) {
@@ -234,52 +161,71 @@ static double test_value(const node *nd, hm_cycle_event_kind kind) {
   return NAN;
 }
 
-static hm_status locate_fn(double sigma, double *value, void *ctx) {
-  locate_ctx *l = (locate_ctx *)ctx;
-  hm_status st = step_from(l->c, l->a, sigma, &l->last, NULL);
-  if (st != HM_OK) return st;
-  *value = test_value(&l->last, l->kind);
-  return HM_OK;
-}
-
-static hm_status locate(hm_sh *c, const node *a, const node *b, double ds, hm_cycle_event_kind kind, node *out) {
-  locate_ctx l = {c, a, kind, *b};
-  double root;
-  hm_status st = hm_brent_root(locate_fn, &l, 0.0, ds, test_value(a, kind), test_value(b, kind),
-                               c->opt->locate_tol, 100, &root);
-  if (st != HM_OK) return st;
-  if ((st = step_from(c, a, root, out, NULL)) != HM_OK) return st;
-  return HM_OK;
-}
+static double test_fn(const void *nd, void *kind) { return test_value((const node *)nd, *(hm_cycle_event_kind *)kind); }
 
 static int sign_change(double x, double y) { return (x > 0.0) != (y > 0.0); }
 
 /* Detect and locate the events between consecutive nodes a and b (b reached from a with step ds). */
-static void detect_events(hm_sh *c, const node *a, const node *b, double ds, size_t index, hm_cycle_event *events,
-                          size_t max_events, size_t *n_events) {
+static void detect_events(cyc *y, const node *a, const node *b, double ds) {
   int flags[4] = {0, 0, 0, 0};
   flags[HM_CYCLE_LPC] = sign_change(a->pub.dparam_ds, b->pub.dparam_ds);
-  flags[HM_CYCLE_BPC] = sign_change(a->bpc, b->bpc) && (c->symmetric || !flags[HM_CYCLE_LPC]);
+  flags[HM_CYCLE_BPC] = sign_change(a->bpc, b->bpc) && (y->sh.symmetric || !flags[HM_CYCLE_LPC]);
   flags[HM_CYCLE_PD] = sign_change(a->pd, b->pd);
   flags[HM_CYCLE_NS] = a->ns_count != b->ns_count && test_value(a, HM_CYCLE_NS) > -INFINITY &&
                        test_value(b, HM_CYCLE_NS) > -INFINITY;
   for (int k = 0; k < 4; ++k) {
     if (!flags[k]) continue;
+    hm_cycle_event_kind kind = (hm_cycle_event_kind)k;
     node located;
-    if (locate(c, a, b, ds, (hm_cycle_event_kind)k, &located) != HM_OK) continue;
+    if (hm_cont_locate(&y->prob, &y->opt->cont, a, ds, test_value(a, kind), test_value(b, kind), test_fn, &kind,
+                       &located) != HM_OK)
+      continue;
     if (k == HM_CYCLE_NS && fabs(test_value(&located, HM_CYCLE_NS)) > 1e-4) continue; /* not a crossing */
     hm_cycle_event ev;
-    ev.kind = (hm_cycle_event_kind)k;
-    ev.index = index;
+    ev.kind = kind;
+    ev.index = y->np;
     ev.point = located.pub;
     ev.stable_side = 0;
     if (k == HM_CYCLE_LPC) {
       const node *upper = a->pub.amp_y_m > b->pub.amp_y_m ? a : b, *lower = upper == a ? b : a;
       ev.stable_side = upper->pub.stable ? 1 : lower->pub.stable ? -1 : 0;
     }
-    if (*n_events < max_events) events[*n_events] = ev;
-    ++*n_events;
+    if (y->ne < y->max_events) y->events[y->ne] = ev;
+    ++y->ne;
   }
+}
+
+static void store(cyc *y, const node *nd) {
+  if (y->np < y->max_points) y->points[y->np] = nd->pub;
+  ++y->np;
+}
+
+static void cyc_accepted(void *ctx, const void *a, const void *b, double ds) {
+  cyc *y = (cyc *)ctx;
+  detect_events(y, (const node *)a, (const node *)b, ds);
+  store(y, (const node *)b);
+}
+
+static int cyc_stop(void *ctx, const void *nd) {
+  const cyc *y = (const cyc *)ctx;
+  const hm_cycle_point *c = &((const node *)nd)->pub;
+  if (c->param < y->opt->p_min || c->param > y->opt->p_max) return HM_CONT_PARAM_RANGE;
+  if (c->amp_y_m > y->opt->amp_max_m) return HM_CONT_AMP_MAX;
+  return HM_CONT_RUNNING;
+}
+
+static hm_status cyc_init(cyc *y, const hm_vehicle *veh, double speed_kmh, const hm_cycle_options *opt) {
+  memset(y, 0, sizeof *y);
+  y->opt = opt;
+  y->prob.n = NU;
+  y->prob.scale = y->sh.sc;
+  y->prob.node_size = sizeof(node);
+  y->prob.ctx = y;
+  y->prob.eval = cyc_eval;
+  y->prob.finish = cyc_finish;
+  y->prob.stop = cyc_stop;
+  y->prob.accepted = cyc_accepted;
+  return hm_sh_init(&y->sh, veh, speed_kmh, opt->param, &opt->shoot, 0, HM_PARAM_SPEED);
 }
 
 /* ---- start at the Hopf point ---- */
@@ -330,110 +276,76 @@ static hm_status start_guess(hm_sh *c, const hm_hopf_point *hopf, double amp, do
 
 static int options_valid(const hm_cycle_options *o) {
   return o->p_max > o->p_min && o->amp_max_m > 0.0 && o->amp_start_m > 0.0 && o->amp_start_m < o->amp_max_m &&
-         o->ds_min > 0.0 && o->ds_init >= o->ds_min && o->ds_max >= o->ds_init && o->rtol > 0.0 &&
-         o->atol >= 0.0 && o->newton_tol > 0.0 && o->newton_max_iter > 0 && o->locate_tol > 0.0;
+         o->shoot.rtol > 0.0 && o->shoot.atol >= 0.0 && hm_cont_options_valid(&o->cont);
 }
 
-/* Solve at fixed amplitude u[0] = amp (the start of the branch). */
-static hm_status solve_fixed(hm_sh *c, double *u, int which, double value, const double *tref, node *nd) {
+/* Solve with unknown `which` fixed at value (the start of the branch, or a cycle at a given parameter). */
+static hm_status solve_fixed(cyc *y, double *u, int which, double value, node *nd) {
   double row[NU] = {0, 0, 0, 0, 0};
   row[which] = 1.0;
-  hm_shot s;
-  hm_status st = newton(c, u, row, value / c->sc[which], &s, NULL);
-  if (st != HM_OK) return st;
-  double t[NU];
-  if ((st = tangent_of(c, &s, tref, t)) != HM_OK) return st;
-  return fill_node(c, &s, u, t, nd);
+  const double tref[NU] = {1, 0, 0, 0, 0}; /* orient the tangent towards growing amplitude */
+  return hm_cont_correct(&y->prob, &y->opt->cont, u, row, value / y->sh.sc[which], tref, nd, NULL);
 }
 
 hm_status hm_cycle_solve(const hm_vehicle *veh, double speed_kmh, const hm_cycle_options *opt, double p,
                          const double x0_guess[4], double period_guess_s, hm_cycle_point *cycle) {
   if (!veh || !opt || !x0_guess || !cycle || !options_valid(opt)) return HM_EINVAL;
-  hm_sh c;
-  hm_status st = hm_sh_init(&c, veh, speed_kmh, opt, 0, HM_PARAM_SPEED);
+  cyc y;
+  hm_status st = cyc_init(&y, veh, speed_kmh, opt);
   if (st == HM_OK) {
     double u[NU] = {x0_guess[0], x0_guess[2], x0_guess[3], period_guess_s, p};
-    const double tref[NU] = {1, 0, 0, 0, 0};
     node nd;
-    st = solve_fixed(&c, u, 4, p, tref, &nd);
+    st = solve_fixed(&y, u, 4, p, &nd);
     if (st == HM_OK) *cycle = nd.pub;
   }
-  hm_sh_free(&c);
+  hm_sh_free(&y.sh);
   return st;
 }
 
-static hm_status start_branch(hm_sh *c, const hm_hopf_point *hopf, node *n0, node *n1) {
+static hm_status start_branch(cyc *y, const hm_hopf_point *hopf, node *n0, node *n1) {
+  hm_sh *c = &y->sh;
   double u[NU];
-  const double amp = c->opt->amp_start_m;
+  const double amp = y->opt->amp_start_m;
   hm_status st = start_guess(c, hopf, amp, u);
   if (st != HM_OK) return st;
-  const double tref[NU] = {1, 0, 0, 0, 0}; /* orient the tangent towards growing amplitude */
-  if ((st = solve_fixed(c, u, 0, amp, tref, n0)) != HM_OK) return st;
+  if ((st = solve_fixed(y, u, 0, amp, n0)) != HM_OK) return st;
   /* second cycle at twice the amplitude: the state scales with it, the parameter shift with its square */
   double u1[NU];
-  memcpy(u1, n0->u, sizeof u1);
+  memcpy(u1, n0->head.u, sizeof u1);
   for (int j = 0; j < 3; ++j) u1[j] *= 2.0;
   const double ph = hopf_param(c, hopf);
-  u1[4] = ph + 4.0 * (n0->u[4] - ph);
-  return solve_fixed(c, u1, 0, 2.0 * amp, tref, n1);
+  u1[4] = ph + 4.0 * (n0->head.u[4] - ph);
+  return solve_fixed(y, u1, 0, 2.0 * amp, n1);
 }
 
 hm_status hm_cycles_continue(const hm_vehicle *veh, double speed_kmh, const hm_hopf_point *hopf,
                              const hm_cycle_options *opt, hm_cycle_point *points, size_t max_points,
                              size_t *n_points, hm_cycle_event *events, size_t max_events, size_t *n_events,
-                             const char **stop_reason) {
+                             hm_cont_stats *stats) {
   if (!veh || !hopf || !opt || !n_points || !n_events || (max_points && !points) || (max_events && !events) ||
       !options_valid(opt))
     return HM_EINVAL;
-  hm_sh c;
-  hm_status st = hm_sh_init(&c, veh, speed_kmh, opt, 0, HM_PARAM_SPEED);
-  const char *reason = "step limit reached";
-  size_t np = 0, ne = 0;
+  cyc y;
+  hm_status st = cyc_init(&y, veh, speed_kmh, opt);
+  y.points = points;
+  y.max_points = max_points;
+  y.events = events;
+  y.max_events = max_events;
   node prev, cur;
-  if (st == HM_OK) st = start_branch(&c, hopf, &prev, &cur);
+  if (st == HM_OK) st = start_branch(&y, hopf, &prev, &cur);
   if (st != HM_OK) {
-    hm_sh_free(&c);
+    hm_sh_free(&y.sh);
     return st;
   }
-  if (np < max_points) points[np] = prev.pub;
-  ++np;
-  if (np < max_points) points[np] = cur.pub;
-  ++np;
-  double ds = opt->ds_init;
-  for (size_t step = 0; step < opt->max_steps; ++step) {
-    if (cur.pub.param < opt->p_min || cur.pub.param > opt->p_max) {
-      reason = "parameter left its range";
-      break;
-    }
-    if (cur.pub.amp_y_m > opt->amp_max_m) {
-      reason = "amplitude limit reached";
-      break;
-    }
-    node next;
-    int iters = 0;
-    st = step_from(&c, &cur, ds, &next, &iters);
-    double dot = 0.0;
-    if (st == HM_OK)
-      for (int j = 0; j < NU; ++j) dot += next.t[j] * cur.t[j];
-    if (st != HM_OK || dot < 0.95) {
-      if (ds <= opt->ds_min) {
-        reason = "no convergence at the smallest step";
-        break;
-      }
-      ds = fmax(0.5 * ds, opt->ds_min);
-      continue;
-    }
-    detect_events(&c, &cur, &next, ds, np, events, max_events, &ne);
-    if (np < max_points) points[np] = next.pub;
-    ++np;
-    prev = cur;
-    cur = next;
-    if (iters <= 2) ds = fmin(1.5 * ds, opt->ds_max);
-    else if (iters >= 5) ds = fmax(0.7 * ds, opt->ds_min);
-  }
-  hm_sh_free(&c);
-  *n_points = np < max_points ? np : max_points;
-  *n_events = ne < max_events ? ne : max_events;
-  if (stop_reason) *stop_reason = reason;
+  store(&y, &prev);
+  store(&y, &cur);
+  hm_cont_stats s;
+  hm_cont_run(&y.prob, &opt->cont, &cur, &prev, &s);
+  hm_sh_free(&y.sh);
+  *n_points = y.np < max_points ? y.np : max_points;
+  *n_events = y.ne < max_events ? y.ne : max_events;
+  s.newton_iterations = y.prob.newton_iterations; /* the start's corrections included */
+  s.shots = y.sh.n_shots;
+  if (stats) *stats = s;
   return HM_OK;
 }

@@ -13,20 +13,21 @@ double hm_sh_param_scale(hm_param p) {
   return p == HM_PARAM_SPEED ? 1.0 : p == HM_PARAM_CONICITY ? 1e-3 : 0.03;
 }
 
-hm_status hm_sh_init(hm_sh *c, const hm_vehicle *veh, double speed_kmh, const hm_cycle_options *opt,
-                     int has_param2, hm_param param2) {
+hm_status hm_sh_init(hm_sh *c, const hm_vehicle *veh, double speed_kmh, hm_param param,
+                     const hm_shooting_options *opt, int has_param2, hm_param param2) {
   memset(c, 0, sizeof *c);
   hm_status st = hm_vehicle_validate(veh, NULL, 0);
   if (st != HM_OK) return st;
   if (!(speed_kmh > 0.0) || !isfinite(speed_kmh)) return HM_EDOMAIN;
   c->base = *veh;
   c->base_speed_kmh = speed_kmh;
-  c->param = opt->param;
+  if (!(opt->rtol > 0.0) || !(opt->atol >= 0.0)) return HM_EINVAL;
+  c->param = param;
   c->param2 = param2;
   c->has_param2 = has_param2;
-  c->opt = opt;
+  c->opt = *opt;
   c->symmetric = opt->use_symmetry && hm_conicity_is_even(&veh->conicity, 1e-12);
-  const double sc[NW] = {1e-3, 1e-3, 1e-1, 1e-2, hm_sh_param_scale(opt->param), hm_sh_param_scale(param2)};
+  const double sc[NW] = {1e-3, 1e-3, 1e-1, 1e-2, hm_sh_param_scale(param), hm_sh_param_scale(param2)};
   memcpy(c->sc, sc, sizeof sc);
   /* without p2 its sensitivity columns are left out of the integration (and of the error control) */
   c->integ = hm_dopri_create(has_param2 ? NZ : NZ - NX);
@@ -98,7 +99,8 @@ hm_status hm_sh_shoot(hm_sh *c, const double *u, hm_shot *s) {
   c->amp_y = fabs(x0[0]);
   c->amp_psi = fabs(x0[2]);
   const hm_ode_system sys = {c->has_param2 ? NZ : NZ - NX, aug_rhs, NULL, c};
-  const hm_dopri_options dopt = {c->opt->rtol, c->opt->atol, 0.0, 0.0, 0};
+  const hm_dopri_options dopt = {c->opt.rtol, c->opt.atol, 0.0, 0.0, 0};
+  ++c->n_shots;
   st = hm_dopri_integrate(c->integ, &sys, &dopt, 0.0, tau, z, NULL, amp_observer, c, NULL);
   if (st != HM_OK) return st;
   double f[NX];

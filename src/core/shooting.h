@@ -21,11 +21,12 @@ typedef struct {
   hm_param param2;       /* p2 (only if has_param2) */
   int has_param2;
   int symmetric;         /* half-period shooting with x(T/2) = -x(0) */
-  const hm_cycle_options *opt;
+  hm_shooting_options opt;
   hm_dopri integ;
   hm_model model;
   double sc[NW];         /* scale of each unknown */
   double amp_y, amp_psi; /* running maxima during an integration */
+  size_t n_shots;        /* integrations so far */
 } hm_sh;
 
 /* One evaluation of the shooting map. */
@@ -38,8 +39,8 @@ typedef struct {
 } hm_shot;
 
 /* Validate, choose symmetric shooting, set scales, allocate the integrator (HM_ENOMEM). */
-hm_status hm_sh_init(hm_sh *c, const hm_vehicle *veh, double speed_kmh, const hm_cycle_options *opt,
-                     int has_param2, hm_param param2);
+hm_status hm_sh_init(hm_sh *c, const hm_vehicle *veh, double speed_kmh, hm_param param,
+                     const hm_shooting_options *opt, int has_param2, hm_param param2);
 void hm_sh_free(hm_sh *c);
 /* Integrate over T/2 (symmetric) or T from x0 = (u0, 0, u1, u2) at p1 = u4 (and p2 = u5). */
 hm_status hm_sh_shoot(hm_sh *c, const double *u, hm_shot *s);

@@ -202,8 +202,8 @@ static hm_status curve_at(const hm_vehicle *veh, const hm_table_spec *spec, doub
   o.p_min = spec->speed_min_kmh;
   o.p_max = fmax(spec->speed_max_kmh, 1.2 * h.speed_kmh);
   o.amp_max_m = spec->amp_max_m;
-  o.rtol = spec->rtol;
-  o.atol = spec->rtol * 1e-3;
+  o.shoot.rtol = spec->rtol;
+  o.shoot.atol = spec->rtol * 1e-3;
   enum { CAP = 20000 };
   hm_cycle_point *pts = malloc(CAP * sizeof *pts);
   tpoint *tp = malloc(CAP * sizeof *tp);

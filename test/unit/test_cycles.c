@@ -30,11 +30,11 @@ static void run(family *f, double kx, double ky, double amp_max, double rtol, do
   o.p_min = 150.0;
   o.p_max = 700.0;
   o.amp_max_m = amp_max;
-  o.rtol = rtol;
-  o.atol = rtol * 1e-3;
-  o.ds_max *= ds_scale;
-  o.ds_init *= ds_scale;
-  o.max_steps = (size_t)(o.max_steps / ds_scale);
+  o.shoot.rtol = rtol;
+  o.shoot.atol = rtol * 1e-3;
+  o.cont.ds_max *= ds_scale;
+  o.cont.ds_init *= ds_scale;
+  o.cont.max_steps = (size_t)(o.cont.max_steps / ds_scale);
   f->pts = malloc(CAP * sizeof *f->pts);
   HM_CHECK(hm_cycles_continue(&f->veh, 500.0, &f->hopf, &o, f->pts, CAP, &f->np, f->ev, 32, &f->ne, NULL) == HM_OK,
            "continuation");
@@ -241,7 +241,7 @@ static void symmetric_and_full_shooting_agree(void) {
   hm_cycle_options sym, full;
   hm_cycle_options_default(&sym, HM_PARAM_SPEED);
   full = sym;
-  full.use_symmetry = 0;
+  full.shoot.use_symmetry = 0;
   const hm_cycle_point *g = nearest_cycle(&study97, 543.0, 5.5e-3);
   hm_cycle_point a, b;
   HM_CHECK(hm_cycle_solve(&study97.veh, 500.0, &sym, 543.0, g->x0, g->period_s, &a) == HM_OK, "symmetric");
