@@ -7,11 +7,11 @@
 
 #include "cli.h"
 #include "hunting_monitor/config.h"
-#include "hunting_monitor/excitation.h"
 #include "hunting_monitor/integrate.h"
 #include "hunting_monitor/linear.h"
 #include "hunting_monitor/lyapunov.h"
 #include "hunting_monitor/model.h"
+#include "hunting_monitor/sensor_sim.h"
 
 #define VEHICLE_OPTIONS CLI_VEHICLE_OPTIONS
 
@@ -142,55 +142,26 @@ static const cli_option simulate_opts[] = {
 
 typedef struct {
   FILE *out, *accel_out, *speed_out;
-  hm_excited_model *em;
-  double dt_out, accel_noise;
-  size_t next_index; /* next output time = next_index * dt_out */
-  double t1, next_speed;
-  unsigned long long rng;
-  hm_status error;
+  int write_error;
 } sim_writer;
 
-static double sim_noise(sim_writer *w) { /* Box-Muller on splitmix64 */
-  double u[2];
-  for (int k = 0; k < 2; ++k) {
-    unsigned long long z = (w->rng += 0x9E3779B97F4A7C15ull);
-    z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9ull;
-    z = (z ^ (z >> 27)) * 0x94D049BB133111EBull;
-    u[k] = ((double)((z ^ (z >> 31)) >> 11) + 0.5) / 9007199254740992.0;
-  }
-  return sqrt(-2.0 * log(u[0])) * cos(2.0 * HM_PI * u[1]);
+static int sim_failed(sim_writer *w) {
+  if (ferror(w->out) || (w->accel_out && ferror(w->accel_out)) || (w->speed_out && ferror(w->speed_out)))
+    w->write_error = 1; /* a full disk: stop integrating for nobody */
+  return w->write_error;
 }
 
-static void write_row(sim_writer *w, double t, const double *x) {
-  double dx[4];
-  hm_status st = hm_excited_rhs(t, x, dx, w->em);
-  if (st != HM_OK) w->error = st;
-  fprintf(w->out, "%.9g,%.12g,%.12g,%.12g,%.12g,%.12g\n", t, x[0], x[1], x[2], x[3], dx[1]);
-  if (w->accel_out) fprintf(w->accel_out, "%.9g,%.9g\n", t, dx[1] + w->accel_noise * sim_noise(w));
-  for (; w->speed_out && w->next_speed <= t + 1e-12; w->next_speed += 0.1)
-    fprintf(w->speed_out, "%.9g,%.9g\n", w->next_speed, hm_excited_speed_kmh(w->em, w->next_speed));
-}
-
-static int sim_observer(hm_dopri integ, double t_old, double t_new, const double *x_new, void *ctx) {
+static int write_accel(void *ctx, double t, double measured, double true_accel, const double *x) {
   sim_writer *w = (sim_writer *)ctx;
-  (void)t_old;
-  (void)x_new;
-  for (;;) {
-    const double t = (double)w->next_index * w->dt_out;
-    if (t > t_new + 1e-12 * w->dt_out || t > w->t1 + 1e-9 * w->dt_out) break;
-    double x[4];
-    if (hm_dopri_dense(integ, fmin(t, t_new), x) != HM_OK) {
-      w->error = HM_EINVAL;
-      return 1;
-    }
-    write_row(w, t, x);
-    if (ferror(w->out) || (w->accel_out && ferror(w->accel_out)) || (w->speed_out && ferror(w->speed_out))) {
-      w->error = HM_EIO; /* a full disk: stop integrating for nobody */
-      return 1;
-    }
-    w->next_index++;
-  }
-  return 0;
+  fprintf(w->out, "%.9g,%.12g,%.12g,%.12g,%.12g,%.12g\n", t, x[0], x[1], x[2], x[3], true_accel);
+  if (w->accel_out) fprintf(w->accel_out, "%.9g,%.9g\n", t, measured);
+  return sim_failed(w);
+}
+
+static int write_speed(void *ctx, double t, double v_kmh) {
+  sim_writer *w = (sim_writer *)ctx;
+  if (w->speed_out) fprintf(w->speed_out, "%.9g,%.9g\n", t, v_kmh);
+  return sim_failed(w);
 }
 
 /* Open each requested output file (NULL where not requested); nonzero on failure. */
@@ -243,38 +214,39 @@ static int cmd_simulate(const cli_args *a) {
     hm_vehicle_linearized(&veh, &lin);
     veh = lin;
   }
-  hm_track track = NULL;
-  hm_status st = scale > 0.0 ? hm_track_create(3.0, 120.0, scale, (uint64_t)seed, &track) : HM_OK;
-  if (st != HM_OK) return fail_status("track irregularity", st);
-  hm_excited_model em;
-  if ((st = hm_excited_model_init(&em, &veh, track, v_kmh, v_end, t_end)) != HM_OK) {
-    hm_track_destroy(track);
-    return fail_status("model", st);
+  hm_sensor_sim_config cfg;
+  hm_sensor_sim_config_default(&cfg);
+  cfg.v_start_kmh = v_kmh;
+  cfg.v_end_kmh = v_end;
+  cfg.ramp_s = t_end;
+  cfg.irregularity_scale = scale;
+  cfg.track_seed = cfg.noise_seed = (uint64_t)seed;
+  cfg.accel_rate_hz = 1.0 / dt_out;
+  cfg.accel_noise_mps2 = noise;
+  cfg.rtol = rtol;
+  cfg.atol = atol;
+  cfg.max_step_s = scale > 0.0 ? 2e-3 : 0.0;
+  hm_sensor_sim sim = NULL;
+  char why[160] = "";
+  hm_status st = hm_sensor_sim_create(&veh, &cfg, x, &sim, why, sizeof why);
+  if (st != HM_OK) {
+    fprintf(stderr, "hunting simulate: %s\n", why);
+    return 1;
   }
   FILE *out = NULL, *acc = NULL, *spd = NULL;
   if (open_outputs(a, &out, &acc, &spd)) {
     close_outputs(a, out, acc, spd);
-    hm_track_destroy(track);
+    hm_sensor_sim_destroy(sim);
     return 1;
   }
   fprintf(out, "t_s,y_m,dy_mps,psi_rad,dpsi_radps,accel_lat_mps2\n");
   if (acc) fprintf(acc, "t_s,accel_mps2\n");
   if (spd) fprintf(spd, "t_s,speed_kmh\n");
-  sim_writer w = {out, acc, spd, &em, dt_out, noise, 1, t_end, 0.0, (unsigned long long)seed * 7919u + 17u, HM_OK};
-  write_row(&w, 0.0, x);
-  hm_dopri integ = hm_dopri_create(4);
-  if (!integ) {
-    close_outputs(a, out, acc, spd);
-    hm_track_destroy(track);
-    return fail_status("integrator", HM_ENOMEM);
-  }
-  const hm_ode_system sys = {4, hm_excited_rhs, NULL, &em};
-  const hm_dopri_options opt = {rtol, atol, 0.0, scale > 0.0 ? 2e-3 : 0.0, 0};
-  st = hm_dopri_integrate(integ, &sys, &opt, 0.0, t_end, x, NULL, sim_observer, &w, NULL);
-  hm_dopri_destroy(integ);
-  hm_track_destroy(track);
-  if (st == HM_OK || w.error == HM_EIO) st = w.error;
-  if (close_outputs(a, out, acc, spd) || st == HM_EIO) return 1;
+  sim_writer w = {out, acc, spd, 0};
+  const hm_sensor_sink sink = {write_accel, write_speed, &w};
+  st = hm_sensor_sim_run(sim, t_end, &sink);
+  hm_sensor_sim_destroy(sim);
+  if (close_outputs(a, out, acc, spd) || w.write_error) return 1;
   if (st != HM_OK) return fail_status("simulation (the trajectory diverged or the step size collapsed)", st);
   return 0;
 }

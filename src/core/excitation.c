@@ -7,24 +7,12 @@
 
 #include "hunting_monitor/linear.h"
 #include "fft.h"
+#include "rng.h"
 
 /* German high-speed alignment spectrum, low disturbance: S(W) = A Wc^2 / ((W^2 + Wr^2)(W^2 + Wc^2)). */
 static double alignment_psd(double w) {
   const double A = 2.119e-7, wc = 0.8246, wr = 0.0206;
   return A * wc * wc / ((w * w + wr * wr) * (w * w + wc * wc));
-}
-
-static double uniform01(uint64_t *s) { /* splitmix64 */
-  uint64_t z = (*s += 0x9E3779B97F4A7C15ull);
-  z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9ull;
-  z = (z ^ (z >> 27)) * 0x94D049BB133111EBull;
-  z ^= z >> 31;
-  return ((double)(z >> 11) + 0.5) / 9007199254740992.0;
-}
-
-static double gaussian(uint64_t *s) { /* Box-Muller */
-  const double u1 = uniform01(s), u2 = uniform01(s);
-  return sqrt(-2.0 * log(u1)) * cos(2.0 * HM_PI * u2);
 }
 
 enum { TRACK_LOG2_N = 18 };                 /* 262144 points */
@@ -72,8 +60,8 @@ hm_status hm_track_create(double wl_min, double wl_max, double scale, uint64_t s
     const double w = dw * (double)k;
     if (w < 2.0 * HM_PI / wl_max || w > 2.0 * HM_PI / wl_min) continue;
     const double c = sqrt(scale * alignment_psd(w) * dw) / 2.0;
-    re[k] = 2.0 * c * gaussian(&rng);
-    im[k] = -2.0 * c * gaussian(&rng); /* conjugated for the inverse */
+    re[k] = 2.0 * c * hm_rng_gaussian(&rng);
+    im[k] = -2.0 * c * hm_rng_gaussian(&rng); /* conjugated for the inverse */
   }
   hm_fft_twiddles(cw, sw, n);
   hm_fft(re, im, n, cw, sw, n);

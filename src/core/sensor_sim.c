@@ -1,0 +1,190 @@
+/* Sensor streams of a simulated run (see sensor_sim.h). */
+#include "hunting_monitor/sensor_sim.h"
+
+#include <math.h>
+#include <stdarg.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "hunting_monitor/excitation.h"
+#include "hunting_monitor/integrate.h"
+#include "rng.h"
+
+struct hm_sensor_sim_s {
+  hm_sensor_sim_config cfg;
+  hm_excited_model em;
+  hm_track track;           /* owned; NULL on a perfect track */
+  hm_dopri integ;
+  double t_s, x[4];
+  uint64_t accel_k, speed_k; /* index of the next sample of each stream */
+  uint64_t rng;
+  const hm_sensor_sink *sink;
+  double t_end_s;
+  int stopped;
+};
+
+void hm_sensor_sim_config_default(hm_sensor_sim_config *cfg) {
+  cfg->v_start_kmh = 450.0;
+  cfg->v_end_kmh = 450.0;
+  cfg->ramp_s = 0.0;
+  cfg->irregularity_scale = 0.0;
+  cfg->wavelength_min_m = 3.0;
+  cfg->wavelength_max_m = 120.0;
+  cfg->track_seed = 1;
+  cfg->noise_seed = 1;
+  cfg->accel_rate_hz = 2000.0;
+  cfg->accel_noise_mps2 = 0.05;
+  cfg->speed_rate_hz = 10.0;
+  cfg->rtol = 1e-8;
+  cfg->atol = 1e-11;
+  cfg->max_step_s = 2e-3;
+}
+
+static hm_status refuse(char *why, size_t len, hm_status st, const char *fmt, ...) {
+  if (why && len) {
+    va_list ap;
+    va_start(ap, fmt);
+    vsnprintf(why, len, fmt, ap);
+    va_end(ap);
+  }
+  return st;
+}
+
+static int rate_ok(double r) { return r > 0.0 && r <= 1e6; }
+
+hm_status hm_sensor_sim_create(const hm_vehicle *veh, const hm_sensor_sim_config *cfg, const double x0[4],
+                               hm_sensor_sim *out, char *why, size_t why_len) {
+  if (!veh || !cfg || !out) return refuse(why, why_len, HM_EINVAL, "missing argument");
+  const hm_sensor_sim_config *c = cfg;
+  hm_status vst = hm_vehicle_validate(veh, why, why_len);
+  if (vst != HM_OK) return vst;
+  if (!(c->v_start_kmh > 0.0) || !(c->v_end_kmh > 0.0) || !isfinite(c->v_start_kmh) || !isfinite(c->v_end_kmh))
+    return refuse(why, why_len, HM_EDOMAIN, "speeds must be finite and > 0 km/h");
+  if (!(c->ramp_s >= 0.0) || !isfinite(c->ramp_s)) return refuse(why, why_len, HM_EDOMAIN, "ramp_s must be >= 0");
+  if (!(c->irregularity_scale >= 0.0) || !isfinite(c->irregularity_scale))
+    return refuse(why, why_len, HM_EDOMAIN, "irregularity scale must be >= 0");
+  if (!(c->wavelength_min_m >= 0.2) || !(c->wavelength_max_m > c->wavelength_min_m) || !(c->wavelength_max_m <= 1000.0))
+    return refuse(why, why_len, HM_EINVAL, "irregularity wavelengths must satisfy 0.2 <= min < max <= 1000 m");
+  if (!rate_ok(c->accel_rate_hz) || !rate_ok(c->speed_rate_hz))
+    return refuse(why, why_len, HM_EINVAL, "sample rates must be in (0, 1e6] Hz");
+  if (!(c->accel_noise_mps2 >= 0.0) || !isfinite(c->accel_noise_mps2))
+    return refuse(why, why_len, HM_EINVAL, "acceleration noise must be >= 0");
+  if (!(c->rtol > 0.0) || !(c->atol >= 0.0) || !(c->max_step_s >= 0.0) || !isfinite(c->max_step_s))
+    return refuse(why, why_len, HM_EINVAL, "need rtol > 0, atol >= 0, max_step_s >= 0");
+  if (x0)
+    for (int i = 0; i < 4; ++i)
+      if (!isfinite(x0[i])) return refuse(why, why_len, HM_EDOMAIN, "initial state not finite");
+  hm_sensor_sim s = calloc(1, sizeof *s);
+  if (!s) return refuse(why, why_len, HM_ENOMEM, "out of memory");
+  s->cfg = *c;
+  hm_status st = HM_OK;
+  if (c->irregularity_scale > 0.0)
+    st = hm_track_create(c->wavelength_min_m, c->wavelength_max_m, c->irregularity_scale, c->track_seed, &s->track);
+  if (st == HM_OK) st = hm_excited_model_init(&s->em, veh, s->track, c->v_start_kmh, c->v_end_kmh, c->ramp_s);
+  if (st == HM_OK && !(s->integ = hm_dopri_create(4))) st = HM_ENOMEM;
+  if (st != HM_OK) {
+    hm_sensor_sim_destroy(s);
+    return refuse(why, why_len, st, st == HM_ENOMEM ? "out of memory" : "cannot set up the run");
+  }
+  if (x0) memcpy(s->x, x0, sizeof s->x);
+  s->rng = c->noise_seed * 0x9E3779B97F4A7C15ull + 0x632BE59BD9B4E019ull;
+  *out = s;
+  return HM_OK;
+}
+
+void hm_sensor_sim_destroy(hm_sensor_sim s) {
+  if (!s) return;
+  hm_dopri_destroy(s->integ);
+  hm_track_destroy(s->track);
+  free(s);
+}
+
+/* Deliver every sample due by t_hi from the state x(t) given by at(t); 1 if a callback stopped. A sample within
+ * 1e-9 of a sample period past t_hi counts as due (k / rate may round above an end time that is a multiple). */
+static int deliver(hm_sensor_sim s, double t_hi, hm_status (*at)(void *, double, double *), void *at_ctx) {
+  const hm_sensor_sink *k = s->sink;
+  const double slack = 1e-9 / s->cfg.accel_rate_hz;
+  for (;;) {
+    const double ta = (double)s->accel_k / s->cfg.accel_rate_hz;
+    if (ta > t_hi + slack || ta > s->t_end_s + slack) return 0;
+    for (;;) { /* the speed samples due by then */
+      const double tv = (double)s->speed_k / s->cfg.speed_rate_hz;
+      if (tv > ta) break;
+      ++s->speed_k;
+      if (k && k->speed && k->speed(k->ctx, tv, hm_excited_speed_kmh(&s->em, tv))) return 1;
+    }
+    double x[4], dx[4];
+    if (at(at_ctx, ta, x) != HM_OK) return 1;
+    hm_excited_rhs(ta, x, dx, &s->em);
+    const double noise = s->cfg.accel_noise_mps2 > 0.0 ? s->cfg.accel_noise_mps2 * hm_rng_gaussian(&s->rng) : 0.0;
+    ++s->accel_k;
+    if (k && k->accel && k->accel(k->ctx, ta, dx[1] + noise, dx[1], x)) return 1;
+  }
+}
+
+typedef struct {
+  hm_dopri integ;
+  double t_old, t_new;
+} dense_ctx;
+
+static hm_status dense_at(void *ctx, double t, double *x) {
+  const dense_ctx *d = (const dense_ctx *)ctx;
+  return hm_dopri_dense(d->integ, fmin(fmax(t, d->t_old), d->t_new), x);
+}
+
+static hm_status state_at(void *ctx, double t, double *x) {
+  (void)t;
+  memcpy(x, ((hm_sensor_sim)ctx)->x, 4 * sizeof(double));
+  return HM_OK;
+}
+
+static int observer(hm_dopri integ, double t_old, double t_new, const double *x_new, void *ctx) {
+  (void)x_new;
+  hm_sensor_sim s = (hm_sensor_sim)ctx;
+  dense_ctx d = {integ, t_old, t_new};
+  if (deliver(s, t_new, dense_at, &d)) {
+    s->stopped = 1;
+    return 1;
+  }
+  return 0;
+}
+
+hm_status hm_sensor_sim_run(hm_sensor_sim s, double t_end_s, const hm_sensor_sink *sink) {
+  if (!s || !(t_end_s >= s->t_s) || !isfinite(t_end_s)) return HM_EINVAL;
+  s->sink = sink;
+  s->t_end_s = t_end_s;
+  s->stopped = 0;
+  /* the samples due now (the first one at t = 0), from the current state */
+  if (deliver(s, s->t_s, state_at, s)) return HM_OK;
+  if (t_end_s == s->t_s) return HM_OK;
+  const hm_ode_system sys = {4, hm_excited_rhs, NULL, &s->em};
+  const hm_dopri_options opt = {s->cfg.rtol, s->cfg.atol, 0.0, s->cfg.max_step_s, 0};
+  double x[4], t_reached = s->t_s;
+  memcpy(x, s->x, sizeof x);
+  hm_status st = hm_dopri_integrate(s->integ, &sys, &opt, s->t_s, t_end_s, x, &t_reached, observer, s, NULL);
+  if (st != HM_OK) return st;
+  memcpy(s->x, x, sizeof x);
+  s->t_s = t_reached;
+  return HM_OK;
+}
+
+double hm_sensor_sim_time(const hm_sensor_sim s) { return s ? s->t_s : NAN; }
+
+void hm_sensor_sim_state(const hm_sensor_sim s, double x[4]) {
+  if (s && x) memcpy(x, s->x, sizeof s->x);
+}
+
+hm_status hm_sensor_sim_set_state(hm_sensor_sim s, const double x[4]) {
+  if (!s || !x) return HM_EINVAL;
+  for (int i = 0; i < 4; ++i)
+    if (!isfinite(x[i])) return HM_EINVAL;
+  memcpy(s->x, x, sizeof s->x);
+  return HM_OK;
+}
+
+double hm_sensor_sim_speed_kmh(const hm_sensor_sim s, double t_s) {
+  return s ? hm_excited_speed_kmh(&s->em, t_s) : NAN;
+}
+
+double hm_sensor_sim_track_rms_m(const hm_sensor_sim s) { return s ? hm_track_rms_m(s->track) : 0.0; }
