@@ -1,6 +1,7 @@
 #include "cli.h"
 
 #include <errno.h>
+#include <getopt.h>
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
@@ -10,43 +11,59 @@
 int cli_parse(const char *command, int argc, char **argv, const cli_option *opts, int allow_positional,
               cli_args *out) {
   memset(out, 0, sizeof *out);
-  for (int i = 0; i < argc; ++i) {
-    const char *arg = argv[i];
-    if (strncmp(arg, "--", 2) != 0) {
-      if (!allow_positional || out->positional) {
-        fprintf(stderr, "hunting %s: unexpected argument '%s' (see hunting %s --help)\n", command, arg, command);
-        return 1;
-      }
-      out->positional = arg;
-      continue;
-    }
-    const cli_option *o = opts;
-    while (o->name && strcmp(o->name, arg + 2) != 0) ++o;
-    if (!o->name) {
-      fprintf(stderr, "hunting %s: unknown option '%s' (see hunting %s --help)\n", command, arg, command);
-      return 1;
-    }
-    if (cli_has(out, o->name)) {
-      fprintf(stderr, "hunting %s: option --%s given twice\n", command, o->name);
-      return 1;
-    }
-    if (out->count == CLI_MAX_ARGS) {
-      fprintf(stderr, "hunting %s: too many options\n", command);
-      return 1;
-    }
-    const char *value = NULL;
-    if (o->arg) {
-      if (i + 1 >= argc) {
-        fprintf(stderr, "hunting %s: option --%s needs a value %s\n", command, o->name, o->arg);
-        return 1;
-      }
-      value = argv[++i];
-    }
-    out->names[out->count] = o->name;
-    out->values[out->count] = value;
-    out->count++;
+  size_t n_opts = 0;
+  while (opts[n_opts].name) ++n_opts;
+  struct option *lo = calloc(n_opts + 1, sizeof *lo);
+  if (!lo) {
+    fprintf(stderr, "hunting %s: out of memory\n", command);
+    return 1;
   }
-  return 0;
+  for (size_t k = 0; k < n_opts; ++k)
+    lo[k] = (struct option){opts[k].name, opts[k].arg ? required_argument : no_argument, NULL, (int)k + 1};
+  /* getopt_long: --name VALUE or --name=VALUE, unambiguous prefixes, "--" ends the options; a value may start
+   * with '-' (--kx -1 reaches the vehicle check). Messages are ours (opterr 0, ':' reports a missing value). */
+  optind = 0;
+  opterr = 0;
+  int rc = 0, c;
+  while (rc == 0 && (c = getopt_long(argc, argv, ":", lo, NULL)) != -1) {
+    if (c == '?') {
+      const char *given = argv[optind - 1], *name = strncmp(given, "--", 2) == 0 ? given + 2 : given;
+      const size_t len = strcspn(name, "=");
+      int matches = 0;
+      for (size_t k = 0; k < n_opts; ++k) matches += strncmp(opts[k].name, name, len) == 0;
+      fprintf(stderr, "hunting %s: %s option '%s' (see hunting %s --help)\n", command,
+              matches > 1 ? "ambiguous" : "unknown", given, command);
+      rc = 1;
+    } else if (c == ':') {
+      const cli_option *o = optopt > 0 && (size_t)optopt <= n_opts ? &opts[optopt - 1] : NULL;
+      if (o) fprintf(stderr, "hunting %s: option --%s needs a value %s\n", command, o->name, o->arg);
+      else fprintf(stderr, "hunting %s: option '%s' needs a value\n", command, argv[optind - 1]);
+      rc = 1;
+    } else {
+      const cli_option *o = &opts[c - 1];
+      if (cli_has(out, o->name)) {
+        fprintf(stderr, "hunting %s: option --%s given twice\n", command, o->name);
+        rc = 1;
+      } else if (out->count == CLI_MAX_ARGS) {
+        fprintf(stderr, "hunting %s: too many options\n", command);
+        rc = 1;
+      } else {
+        out->names[out->count] = o->name;
+        out->values[out->count] = o->arg ? optarg : NULL;
+        out->count++;
+      }
+    }
+  }
+  free(lo);
+  for (int i = optind; rc == 0 && i < argc; ++i) {
+    if (!allow_positional || out->positional) {
+      fprintf(stderr, "hunting %s: unexpected argument '%s' (see hunting %s --help)\n", command, argv[i], command);
+      rc = 1;
+    } else {
+      out->positional = argv[i];
+    }
+  }
+  return rc;
 }
 
 int cli_has(const cli_args *a, const char *name) {

@@ -23,7 +23,9 @@ typedef struct {
   const char *positional;           /* at most one positional argument */
 } cli_args;
 
-/* Parse argv against the options; prints the error to stderr and returns nonzero on a bad command line. */
+/* Parse argv (argv[0] is the command's name) against the options with getopt_long: --name VALUE, --name=VALUE,
+ * unambiguous prefixes, "--" before positional arguments. Prints the error to stderr and returns nonzero on a bad
+ * command line. Reorders argv (non-options last). */
 int cli_parse(const char *command, int argc, char **argv, const cli_option *opts, int allow_positional,
               cli_args *out);
 int cli_has(const cli_args *a, const char *name);

@@ -471,7 +471,7 @@ int main(int argc, char **argv) {
     if (strcmp(argv[1], c->name) != 0) continue;
     cli_args args;
     const int positional = c->run == cmd_fit_conicity; /* the data file */
-    if (cli_parse(c->name, argc - 2, argv + 2, c->opts, positional, &args)) return 2;
+    if (cli_parse(c->name, argc - 1, argv + 1, c->opts, positional, &args)) return 2;
     if (cli_has(&args, "help")) {
       cli_print_help(stdout, c->name, c->usage, c->summary, c->opts);
       return 0;

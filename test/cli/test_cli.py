@@ -57,6 +57,10 @@ def test_critical_default_vehicle_and_config_file():
     # MODEL.md section 6, nonlinear Hopf speeds (Ky = 10.96)
     for kx, ref in [(9.1, 527.4349), (9.7, 544.3795), (9.9, 550.3513)]:
         close(run_json("critical", "--kx", str(kx), "--ky", "10.96")["v_crit_kmh"], ref, 1e-3, f"Hopf kx={kx}")
+    # the same through getopt_long's other spellings: --name=value and an unambiguous prefix (--conic for --conicity)
+    close(run_json("critical", "--kx=9.7", "--ky=10.96")["v_crit_kmh"], 544.3795, 1e-3, "Hopf --kx=9.7")
+    close(run_json("critical", "--kx", "8.96", "--ky", "8.96", "--conic", "0.1271")["v_crit_kmh"], 536.634923, 1e-3,
+          "Hopf --conic 0.1271")
 
 
 def test_critical_conicity_inverts_critical_speed():
@@ -120,6 +124,9 @@ def test_bad_input_gives_clear_errors():
         (["eig"], "--v KM/H (running speed) is required"),
         (["eig", "--v", "-5"], "--v must be > 0"),
         (["critical", "--bogus"], "unknown option '--bogus'"),
+        (["critical", "--k", "9"], "ambiguous option '--k'"),
+        (["critical", "--kx"], "option --kx needs a value MN/m"),
+        (["eig", "--v", "450", "stray"], "unexpected argument 'stray'"),
         (["critical", "--config", "/nonexistent.yaml"], "cannot open"),
         (["simulate", "--v", "500", "--x0", "1,2,3"], "expected 4 comma-separated finite numbers"),
         (["simulate", "--v", "500", "--t", "-1"], "need --t > 0"),
