@@ -294,7 +294,7 @@ int main(void) {
   /* 100 s of model time at 543 km/h, rtol 1e-9 (atol 1e-12), from MODEL.md's x0 (0.001, 0.001, 0.006, 0.06). */
   hm_dopri integ = hm_dopri_create(4);
   const hm_ode_system sys = {4, hm_model_rhs, hm_model_jacobian, &model};
-  const hm_dopri_options opt = {1e-9, 1e-12, 0.0, 0.0, 0};
+  const hm_dopri_options opt = {1e-9, 1e-12, 0.0, 0.0, 0, 0};
   double xs[4] = {0.001, 0.001, 0.006, 0.06};
   hm_dopri_stats stats = {0, 0, 0};
   t0 = now_s();

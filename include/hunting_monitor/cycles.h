@@ -39,26 +39,32 @@ typedef struct {
 /*
  * Pseudo-arclength continuation, shared by cycle families and LPC curves: predictor along the unit tangent,
  * Newton's corrector orthogonal to it (an update above 50 scaled units counts as divergence), then step control.
- * A step is rejected and retried at half the length (down to ds_min) when the corrector fails, lands farther
- * than max(|ds|, jump_floor) from the predictor (a jump to another branch) or turns the tangent by more than
- * acos(min_tangent_cos). After an accepted step ds grows by grow_factor (up to ds_max) when Newton needed at most
+ * Newton has converged when its update, or the error left after it as estimated from the last two updates
+ * (d_k^2 / d_(k-1), the linear-convergence bound), is below newton_tol. A step is rejected and retried at half
+ * the length (down to ds_min) when the corrector fails, lands farther than max(|ds|, jump_floor) from the
+ * predictor (a jump to another branch) or turns the tangent by more than acos(min_tangent_cos). After an accepted
+ * step, with predictor_tol > 0, ds is scaled by sqrt(predictor_tol / e) within [shrink_factor, grow_factor], e the
+ * distance from predictor to corrector (the predictor's error grows as ds^2): few points where the branch is
+ * straight, many where it bends. With predictor_tol = 0, ds grows by grow_factor when Newton needed at most
  * fast_newton_iters iterations and shrinks by shrink_factor when it needed slow_newton_iters or more.
  */
 typedef struct {
-  double ds_init, ds_min, ds_max; /* arclength steps (scaled units, see above) */
+  double ds_init, ds_min, ds_max; /* arclength steps (scaled units, see above): 0.2, 1e-4, 20 */
   size_t max_steps;         /* step attempts, accepted or rejected (per direction for LPC curves) */
+  double predictor_tol;     /* 0.03 scaled units (30 um or 0.03 km/h); 0: step control by Newton iterations */
   double min_tangent_cos;   /* cycles 0.95; LPC curves 0.9 (their fold row makes the tangent noisier) */
-  int fast_newton_iters;    /* cycles 2; LPC curves 3 (their fold-test row is a chord: one more iteration) */
-  int slow_newton_iters;    /* cycles 5; LPC curves 6 */
+  int fast_newton_iters;    /* (predictor_tol = 0) cycles 2; LPC curves 3 (their fold-test row is a chord) */
+  int slow_newton_iters;    /* (predictor_tol = 0) cycles 5; LPC curves 6 */
   double grow_factor;       /* 1.5 */
   double shrink_factor;     /* 0.7 */
   double jump_floor;        /* 0.05 scaled units */
-  double newton_tol;        /* Newton stops when the scaled update is below this (max norm): 1e-9 */
+  double newton_tol;        /* 1e-9 (max norm of the scaled update or of the estimated error) */
   size_t newton_max_iter;   /* 8 */
   double locate_tol;        /* events are located to this arclength (scaled units): 1e-9 */
 } hm_cont_options;
 
-/* The cycle-family defaults above (ds 0.2 in 0.0001..5, 2000 steps, 0.95, 2/5, 1.5/0.7, 0.05, 1e-9, 8, 1e-9). */
+/* The cycle-family defaults above (ds 0.2 in 0.0001..20, 2000 steps, 0.03, 0.95, 2/5, 1.5/0.7, 0.05, 1e-9, 8,
+ * 1e-9). */
 void hm_cont_options_default(hm_cont_options *opt);
 /* 1 if the settings are usable (positive steps in order, 0 < min_tangent_cos < 1, fast < slow, ...). */
 int hm_cont_options_valid(const hm_cont_options *opt);
@@ -81,6 +87,7 @@ typedef struct {
   size_t rejected;          /* rejected step attempts */
   size_t newton_iterations; /* Newton iterations of the run, event location included */
   size_t shots;             /* integrations of the shooting system (LPC: the fold test's gradient included) */
+  size_t integration_steps; /* Dormand-Prince steps of those integrations */
 } hm_cont_stats;
 
 typedef struct {
@@ -142,6 +149,10 @@ hm_status hm_cycles_continue(const hm_vehicle *veh, double speed_kmh, const hm_h
                              size_t *n_points, hm_cycle_event *events, size_t max_events, size_t *n_events,
                              hm_cont_stats *stats);
 
+/* The lowest parameter value on a computed branch: the smallest over its points and its located folds (a fold
+ * between two points lies below both). +inf for an empty branch. */
+double hm_cycles_lowest(const hm_cycle_point *points, size_t n_points, const hm_cycle_event *events, size_t n_events);
+
 /*
  * One cycle at fixed parameter value p near the guess (x0 with dy/dt = 0, period) by Newton's method on the
  * shooting equations (opt->shoot and opt->cont's Newton settings). HM_ENOCONV if Newton does not converge.
@@ -160,7 +171,7 @@ typedef struct {
 } hm_lpc_options;
 
 /* Defaults: p2 in [0.1, 100] (or conicity [0.001, 2]), amp_min 0.5 mm, fd 1e-6, and the continuation defaults
- * but ds 0.1..5, 400 steps per direction, min_tangent_cos 0.9 and Newton thresholds 3/6. */
+ * but ds_init 0.1, 400 steps per direction, min_tangent_cos 0.9 and Newton thresholds 3/6. */
 void hm_lpc_options_default(hm_lpc_options *opt, hm_param param2);
 
 typedef struct {

@@ -57,6 +57,7 @@ typedef struct {
   double h_init;       /* first step; 0 chooses one automatically */
   double h_max;        /* largest step; 0 means |t1 - t0| */
   size_t max_steps;    /* accepted + rejected step limit; 0 means 10^8 */
+  size_t err_dim;      /* the error is controlled on components [0, err_dim) only; 0 means all */
 } hm_dopri_options;
 
 typedef struct {
@@ -78,7 +79,8 @@ void hm_dopri_destroy(hm_dopri integ);
 
 /*
  * Integrate from t0 to t1 > t0 starting at x (length dim). Error per step: the weighted RMS norm of the
- * embedded error estimate, weights atol + rtol max(|x_old|, |x_new|), must be <= 1; the step size follows
+ * embedded error estimate over the controlled components (opt->err_dim, or all), weights atol + rtol
+ * max(|x_old|, |x_new|), must be <= 1 (the first step is chosen from the same components); the step size follows
  * h_new = h min(5, max(0.2, 0.9 err^(-1/5))); a step whose stages are not finite is rejected and retried
  * with h/5. Fails with HM_ESTEP if the step falls below 1e-14 max(1, |t|) or the step limit is hit,
  * HM_ENONFINITE if that collapse came from non-finite values or x is not finite, or the rhs's own error.

@@ -224,6 +224,7 @@ static void write_cont_stats(json_writer *w, const char *key, const hm_cont_stat
   jw_number(w, "rejected_steps", (double)s->rejected);
   jw_number(w, "newton_iterations", (double)s->newton_iterations);
   jw_number(w, "shots", (double)s->shots);
+  jw_number(w, "integration_steps", (double)s->integration_steps);
   jw_end_object(w);
 }
 
@@ -239,8 +240,7 @@ static void write_family_json(FILE *f, const hm_hopf_point *hopf, const family *
   write_events(&w, "branch_points", fam, HM_CYCLE_BPC, pname);
   write_events(&w, "period_doublings", fam, HM_CYCLE_PD, pname);
   write_events(&w, "neimark_sacker", fam, HM_CYCLE_NS, pname);
-  double lowest = INFINITY;
-  for (size_t i = 0; i < fam->n_points; ++i) lowest = fmin(lowest, fam->points[i].param);
+  const double lowest = hm_cycles_lowest(fam->points, fam->n_points, fam->events, fam->n_events);
   jw_number(&w, p == HM_PARAM_SPEED ? "lowest_cycle_v_kmh" : "lowest_cycle_param", lowest);
   jw_string(&w, "stop_reason", hm_cont_stop_name(fam->stats.stop));
   write_cont_stats(&w, "continuation", &fam->stats);
@@ -305,6 +305,7 @@ int cmd_cycles(const cli_args *a) {
     of.shoot.atol *= 1e-2;
     of.cont.ds_max *= 0.25;
     of.cont.ds_init *= 0.25;
+    of.cont.predictor_tol /= 16.0; /* 4x smaller steps where the predictor's error sets them */
     of.cont.max_steps *= 4;
     rc = run_family(&veh, speed, &hopf, &of, &fine);
   }

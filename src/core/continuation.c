@@ -24,7 +24,7 @@ const char *hm_cont_stop_name(hm_cont_stop stop) {
 void hm_cont_options_default(hm_cont_options *o) {
   o->ds_init = 0.2;
   o->ds_min = 1e-4;
-  o->ds_max = 5.0;
+  o->ds_max = 20.0;
   o->max_steps = 2000;
   o->min_tangent_cos = 0.95;
   o->fast_newton_iters = 2;
@@ -32,6 +32,7 @@ void hm_cont_options_default(hm_cont_options *o) {
   o->grow_factor = 1.5;
   o->shrink_factor = 0.7;
   o->jump_floor = 0.05;
+  o->predictor_tol = 0.03;
   o->newton_tol = 1e-9;
   o->newton_max_iter = 8;
   o->locate_tol = 1e-9;
@@ -41,7 +42,7 @@ int hm_cont_options_valid(const hm_cont_options *o) {
   return o && o->ds_min > 0.0 && o->ds_init >= o->ds_min && o->ds_max >= o->ds_init && isfinite(o->ds_max) &&
          o->max_steps > 0 && o->min_tangent_cos > 0.0 && o->min_tangent_cos < 1.0 && o->fast_newton_iters >= 1 &&
          o->slow_newton_iters > o->fast_newton_iters && o->grow_factor >= 1.0 && isfinite(o->grow_factor) &&
-         o->shrink_factor > 0.0 && o->shrink_factor <= 1.0 && o->jump_floor >= 0.0 && o->newton_tol > 0.0 &&
+         o->shrink_factor > 0.0 && o->shrink_factor <= 1.0 && o->jump_floor >= 0.0 && o->predictor_tol >= 0.0 && isfinite(o->predictor_tol) && o->newton_tol > 0.0 &&
          o->newton_max_iter > 0 && o->locate_tol > 0.0;
 }
 
@@ -65,6 +66,7 @@ hm_status hm_cont_correct(hm_cont_problem *p, const hm_cont_options *o, double *
   memset(jac, 0, sizeof jac);
   size_t it = 0;
   int converged = 0;
+  double dprev = INFINITY;
   for (; it < o->newton_max_iter && !converged; ++it) {
     hm_status st = p->eval(p->ctx, w, (int)it, res, jac);
     ++p->newton_iterations;
@@ -80,7 +82,10 @@ hm_status hm_cont_correct(hm_cont_problem *p, const hm_cont_options *o, double *
       dmax = fmax(dmax, fabs(b[j]));
     }
     if (!isfinite(dmax) || dmax > 50.0) return HM_ENOCONV; /* diverging */
-    converged = dmax <= o->newton_tol;
+    /* converged when the update, or the error left after it, is below the tolerance: at a contraction rate
+     * dmax / dprev (linear at worst: the LPC system's chord row) the remaining error is about dmax^2 / dprev */
+    converged = dmax <= o->newton_tol || (isfinite(dprev) && dmax < 0.5 * dprev && dmax * dmax <= o->newton_tol * dprev);
+    dprev = dmax;
   }
   if (!converged) return HM_ENOCONV;
   /* tangent: the null vector of the Jacobian (last evaluation), normalised and oriented along tref */
@@ -103,28 +108,36 @@ hm_status hm_cont_correct(hm_cont_problem *p, const hm_cont_options *o, double *
   return HM_OK;
 }
 
-hm_status hm_cont_step(hm_cont_problem *p, const hm_cont_options *o, const void *a, double sigma, void *out,
-                       int *iters) {
+/* The step from a of length sigma; Newton starts from the predictor, or, given a point `near` on the branch that
+ * satisfies the arclength condition at near_sigma, from near moved along a's tangent to sigma (event location). */
+static hm_status cont_step(hm_cont_problem *p, const hm_cont_options *o, const void *a, double sigma, void *out,
+                           int *iters, double *pred_err, const double *near, double near_sigma) {
   const hm_cont_point *pa = (const hm_cont_point *)a;
   const size_t n = p->n;
   double w[MAXN], pred[MAXN], target = 0.0;
   for (size_t j = 0; j < n; ++j) {
-    w[j] = pa->u[j] + sigma * pa->t[j] * p->scale[j];
-    target += pa->t[j] * w[j] / p->scale[j];
+    pred[j] = pa->u[j] + sigma * pa->t[j] * p->scale[j];
+    target += pa->t[j] * pred[j] / p->scale[j];
+    w[j] = near ? near[j] + (sigma - near_sigma) * pa->t[j] * p->scale[j] : pred[j];
   }
-  memcpy(pred, w, sizeof pred);
   hm_status st = hm_cont_correct(p, o, w, pa->t, target, pa->t, out, iters);
   if (st != HM_OK) return st;
   /* A corrector that lands farther from the predictor than the step itself has jumped to another branch
    * (for cycles typically the trivial one, x0 = 0, which solves the shooting equations for every T and p). */
   double dist = 0.0;
   for (size_t j = 0; j < n; ++j) dist += (w[j] - pred[j]) * (w[j] - pred[j]) / (p->scale[j] * p->scale[j]);
+  if (pred_err) *pred_err = sqrt(dist);
   return sqrt(dist) > fmax(fabs(sigma), o->jump_floor) ? HM_ENOCONV : HM_OK;
+}
+
+hm_status hm_cont_step(hm_cont_problem *p, const hm_cont_options *o, const void *a, double sigma, void *out,
+                       int *iters) {
+  return cont_step(p, o, a, sigma, out, iters, NULL, NULL, 0.0);
 }
 
 hm_cont_stop hm_cont_run(hm_cont_problem *p, const hm_cont_options *o, void *cur, void *scratch,
                          hm_cont_stats *stats) {
-  hm_cont_stats s = {HM_CONT_STEP_LIMIT, 0, 0, 0, 0};
+  hm_cont_stats s = {HM_CONT_STEP_LIMIT, 0, 0, 0, 0, 0};
   const size_t newton0 = p->newton_iterations;
   double ds = o->ds_init;
   for (size_t attempt = 0; attempt < o->max_steps; ++attempt) {
@@ -134,7 +147,8 @@ hm_cont_stop hm_cont_run(hm_cont_problem *p, const hm_cont_options *o, void *cur
       break;
     }
     int iters = 0;
-    hm_status st = hm_cont_step(p, o, cur, ds, scratch, &iters);
+    double pred_err = 0.0;
+    hm_status st = cont_step(p, o, cur, ds, scratch, &iters, &pred_err, NULL, 0.0);
     double dot = 0.0;
     if (st == HM_OK)
       for (size_t j = 0; j < p->n; ++j) dot += ((hm_cont_point *)scratch)->t[j] * ((hm_cont_point *)cur)->t[j];
@@ -150,7 +164,11 @@ hm_cont_stop hm_cont_run(hm_cont_problem *p, const hm_cont_options *o, void *cur
     if (p->accepted) p->accepted(p->ctx, cur, scratch, ds);
     memcpy(cur, scratch, p->node_size);
     ++s.steps;
-    if (iters <= o->fast_newton_iters) ds = fmin(o->grow_factor * ds, o->ds_max);
+    if (o->predictor_tol > 0.0) {
+      /* the tangent predictor's error grows as ds^2 */
+      const double f = pred_err > 0.0 ? sqrt(o->predictor_tol / pred_err) : o->grow_factor;
+      ds = fmin(fmax(ds * fmin(fmax(f, o->shrink_factor), o->grow_factor), o->ds_min), o->ds_max);
+    } else if (iters <= o->fast_newton_iters) ds = fmin(o->grow_factor * ds, o->ds_max);
     else if (iters >= o->slow_newton_iters) ds = fmax(o->shrink_factor * ds, o->ds_min);
   }
   s.newton_iterations = p->newton_iterations - newton0;
@@ -165,20 +183,27 @@ typedef struct {
   void *node;
   double (*test)(const void *node, void *arg);
   void *arg;
+  double near[MAXN], near_sigma; /* the latest point found, the start of the next correction */
 } locate_ctx;
 
 static hm_status locate_fn(double sigma, double *value, void *ctx) {
   locate_ctx *l = (locate_ctx *)ctx;
-  hm_status st = hm_cont_step(l->p, l->o, l->a, sigma, l->node, NULL);
-  if (st == HM_OK) *value = l->test(l->node, l->arg);
+  hm_status st = cont_step(l->p, l->o, l->a, sigma, l->node, NULL, NULL, l->near, l->near_sigma);
+  if (st == HM_OK) {
+    *value = l->test(l->node, l->arg);
+    memcpy(l->near, ((const hm_cont_point *)l->node)->u, sizeof l->near);
+    l->near_sigma = sigma;
+  }
   return st;
 }
 
-hm_status hm_cont_locate(hm_cont_problem *p, const hm_cont_options *o, const void *a, double ds, double fa, double fb,
-                         double (*test)(const void *node, void *arg), void *arg, void *out) {
-  locate_ctx l = {p, o, a, out, test, arg};
+hm_status hm_cont_locate(hm_cont_problem *p, const hm_cont_options *o, const void *a, const void *b, double ds,
+                         double fa, double fb, double (*test)(const void *node, void *arg), void *arg, void *out) {
+  locate_ctx l = {p, o, a, out, test, arg, {0}, ds};
+  memcpy(l.near, ((const hm_cont_point *)b)->u, sizeof l.near);
   double root;
   hm_status st = hm_brent_root(locate_fn, &l, 0.0, ds, fa, fb, o->locate_tol, 100, &root);
-  if (st != HM_OK) return st;
-  return hm_cont_step(p, o, a, root, out, NULL);
+  if (st == HM_OK && root != l.near_sigma) /* else out holds the point found last, at the root */
+    st = cont_step(p, o, a, root, out, NULL, NULL, l.near, l.near_sigma);
+  return st;
 }

@@ -54,9 +54,10 @@ hm_status hm_cont_step(hm_cont_problem *p, const hm_cont_options *o, const void 
 hm_cont_stop hm_cont_run(hm_cont_problem *p, const hm_cont_options *o, void *cur, void *scratch,
                          hm_cont_stats *stats);
 
-/* Locate the zero of test(node) between node a (value fa) and the node a step ds further (value fb) by Brent's
- * method along the arclength to o->locate_tol; out gets the node there. */
-hm_status hm_cont_locate(hm_cont_problem *p, const hm_cont_options *o, const void *a, double ds, double fa, double fb,
-                         double (*test)(const void *node, void *arg), void *arg, void *out);
+/* Locate the zero of test(node) between node a (value fa) and node b, the step ds further (value fb), by Brent's
+ * method along the arclength to o->locate_tol; out gets the node there. Each correction starts from the point
+ * found last (at first b), moved along a's tangent. */
+hm_status hm_cont_locate(hm_cont_problem *p, const hm_cont_options *o, const void *a, const void *b, double ds,
+                         double fa, double fb, double (*test)(const void *node, void *arg), void *arg, void *out);
 
 #endif

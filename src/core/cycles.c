@@ -177,7 +177,7 @@ static void detect_events(cyc *y, const node *a, const node *b, double ds) {
     if (!flags[k]) continue;
     hm_cycle_event_kind kind = (hm_cycle_event_kind)k;
     node located;
-    if (hm_cont_locate(&y->prob, &y->opt->cont, a, ds, test_value(a, kind), test_value(b, kind), test_fn, &kind,
+    if (hm_cont_locate(&y->prob, &y->opt->cont, a, b, ds, test_value(a, kind), test_value(b, kind), test_fn, &kind,
                        &located) != HM_OK)
       continue;
     if (k == HM_CYCLE_NS && fabs(test_value(&located, HM_CYCLE_NS)) > 1e-4) continue; /* not a crossing */
@@ -274,6 +274,14 @@ static hm_status start_guess(hm_sh *c, const hm_hopf_point *hopf, double amp, do
   return HM_OK;
 }
 
+double hm_cycles_lowest(const hm_cycle_point *points, size_t n_points, const hm_cycle_event *events, size_t n_events) {
+  double lowest = INFINITY;
+  for (size_t i = 0; points && i < n_points; ++i) lowest = fmin(lowest, points[i].param);
+  for (size_t i = 0; events && i < n_events; ++i)
+    if (events[i].kind == HM_CYCLE_LPC) lowest = fmin(lowest, events[i].point.param);
+  return lowest;
+}
+
 static int options_valid(const hm_cycle_options *o) {
   return o->p_max > o->p_min && o->amp_max_m > 0.0 && o->amp_start_m > 0.0 && o->amp_start_m < o->amp_max_m &&
          o->shoot.rtol > 0.0 && o->shoot.atol >= 0.0 && hm_cont_options_valid(&o->cont);
@@ -346,6 +354,7 @@ hm_status hm_cycles_continue(const hm_vehicle *veh, double speed_kmh, const hm_h
   *n_events = y.ne < max_events ? y.ne : max_events;
   s.newton_iterations = y.prob.newton_iterations; /* the start's corrections included */
   s.shots = y.sh.n_shots;
+  s.integration_steps = y.sh.n_steps;
   if (stats) *stats = s;
   return HM_OK;
 }

@@ -112,14 +112,16 @@ static hm_status dopri_try(hm_dopri d, const hm_ode_system *sys, double t, doubl
 }
 
 /* Weighted RMS norm of the error estimate; +inf if anything is not finite. */
-static double dopri_error_norm(const hm_dopri d, double rtol, double atol) {
+static double dopri_error_norm(const hm_dopri d, double rtol, double atol, size_t err_dim) {
   double s = 0.0;
-  for (size_t i = 0; i < d->dim; ++i) {
+  const size_t m = err_dim && err_dim < d->dim ? err_dim : d->dim;
+  for (size_t i = 0; i < m; ++i) {
     const double sc = atol + rtol * fmax(fabs(d->x[i]), fabs(d->xnew[i]));
     const double e = d->err[i] / sc;
     s += e * e;
   }
-  s = sqrt(s / (double)d->dim);
+  s = sqrt(s / (double)m);
+  for (size_t i = m; i < d->dim; ++i) s += 0.0 * d->err[i]; /* a non-finite variation still fails the step */
   return isfinite(s) ? s : INFINITY;
 }
 
@@ -159,7 +161,7 @@ hm_status hm_dopri_dense(const hm_dopri d, double t, double *x_out) {
 /* Hairer's starting-step heuristic (Solving ODEs I, II.4) with one explicit Euler probe. */
 static hm_status dopri_initial_step(hm_dopri d, const hm_ode_system *sys, const hm_dopri_options *opt, double t,
                                     double h_max, double *h_out) {
-  const size_t n = d->dim;
+  const size_t n = opt->err_dim && opt->err_dim < d->dim ? opt->err_dim : d->dim; /* the controlled components */
   double d0 = 0.0, d1 = 0.0;
   for (size_t i = 0; i < n; ++i) {
     const double sc = opt->atol + opt->rtol * fabs(d->x[i]);
@@ -170,7 +172,7 @@ static hm_status dopri_initial_step(hm_dopri d, const hm_ode_system *sys, const 
   d1 = sqrt(d1 / (double)n);
   double h0 = (d0 < 1e-5 || d1 < 1e-5) ? 1e-6 : 0.01 * d0 / d1;
   h0 = fmin(h0, h_max);
-  for (size_t i = 0; i < n; ++i) d->xs[i] = d->x[i] + h0 * d->k1[i];
+  for (size_t i = 0; i < d->dim; ++i) d->xs[i] = d->x[i] + h0 * d->k1[i];
   hm_status st = sys->rhs(t + h0, d->xs, d->k2, sys->params);
   if (st != HM_OK) return st;
   double d2 = 0.0;
@@ -231,7 +233,7 @@ hm_status hm_dopri_integrate(hm_dopri d, const hm_ode_system *sys, const hm_dopr
     else if (st != HM_OK)
       return st;
     else
-      err = dopri_error_norm(d, opt->rtol, opt->atol);
+      err = dopri_error_norm(d, opt->rtol, opt->atol, opt->err_dim);
     last_nonfinite = !isfinite(err);
     if (err <= 1.0) {
       dopri_store_dense(d, t, h);

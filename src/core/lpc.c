@@ -126,7 +126,7 @@ static void lpc_accepted(void *ctx, const void *a, const void *b, double ds) {
   const lnode *cur = (const lnode *)a, *next = (const lnode *)b;
   if ((cur->head.t[5] > 0.0) != (next->head.t[5] > 0.0)) {
     lnode cusp;
-    if (hm_cont_locate(&l->prob, &l->lopt->cont, cur, ds, cur->head.t[5], next->head.t[5], dp2_ds, NULL, &cusp) ==
+    if (hm_cont_locate(&l->prob, &l->lopt->cont, cur, next, ds, cur->head.t[5], next->head.t[5], dp2_ds, NULL, &cusp) ==
         HM_OK) {
       if (l->n_cusps < l->max_cusps) l->cusps[l->n_cusps] = to_point(&cusp);
       ++l->n_cusps;
@@ -141,10 +141,11 @@ static void trace(lctx *l, const lnode *start, hm_lpc_point *buf, size_t cap, si
   l->buf = buf;
   l->cap = cap;
   l->n = 0;
-  const size_t shots0 = l->sh.n_shots;
+  const size_t shots0 = l->sh.n_shots, steps0 = l->sh.n_steps;
   lnode cur = *start, scratch;
   hm_cont_run(&l->prob, &l->lopt->cont, &cur, &scratch, stats);
   stats->shots = l->sh.n_shots - shots0;
+  stats->integration_steps = l->sh.n_steps - steps0;
   *n = l->n;
 }
 
@@ -186,7 +187,7 @@ hm_status hm_lpc_curve(const hm_vehicle *veh, double speed_kmh, const hm_cycle_o
     hm_sh_free(&l.sh);
     return st;
   }
-  const size_t start_newton = l.prob.newton_iterations, start_shots = l.sh.n_shots;
+  const size_t start_newton = l.prob.newton_iterations, start_shots = l.sh.n_shots, start_steps = l.sh.n_steps;
   /* backward half first (reversed into the output), then the start point and the forward half */
   hm_lpc_point back[512], fwd[512];
   size_t nb = 0, nf = 0;
@@ -197,6 +198,7 @@ hm_status hm_lpc_curve(const hm_vehicle *veh, double speed_kmh, const hm_cycle_o
   trace(&l, &start, fwd, 512, &nf, &s[1]);
   s[0].newton_iterations += start_newton;
   s[0].shots += start_shots;
+  s[0].integration_steps += start_steps;
   hm_sh_free(&l.sh);
   if (nb > 512) nb = 512;
   if (nf > 512) nf = 512;

@@ -76,7 +76,7 @@ static hm_status work_alloc(lyap_work *w, const hm_ode_system *sys, size_t k, hm
 static hm_status advance(lyap_work *w, const hm_ode_system *sys, const hm_lyap_options *opt, double t,
                          double interval, size_t midpoint_steps) {
   if (opt->method == HM_LYAP_DOPRI) {
-    const hm_dopri_options dopt = {opt->rtol, opt->atol, 0.0, 0.0, 0};
+    const hm_dopri_options dopt = {opt->rtol, opt->atol, 0.0, 0.0, 0, 0};
     return hm_dopri_integrate(w->dopri, &w->var_sys, &dopt, t, t + interval, w->z, NULL, NULL, NULL, NULL);
   }
   for (size_t s = 0; s < midpoint_steps; ++s) {

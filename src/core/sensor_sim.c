@@ -159,7 +159,7 @@ hm_status hm_sensor_sim_run(hm_sensor_sim s, double t_end_s, const hm_sensor_sin
   if (deliver(s, s->t_s, state_at, s)) return HM_OK;
   if (t_end_s == s->t_s) return HM_OK;
   const hm_ode_system sys = {4, hm_excited_rhs, NULL, &s->em};
-  const hm_dopri_options opt = {s->cfg.rtol, s->cfg.atol, 0.0, s->cfg.max_step_s, 0};
+  const hm_dopri_options opt = {s->cfg.rtol, s->cfg.atol, 0.0, s->cfg.max_step_s, 0, 0};
   double x[4], t_reached = s->t_s;
   memcpy(x, s->x, sizeof x);
   hm_status st = hm_dopri_integrate(s->integ, &sys, &opt, s->t_s, t_end_s, x, &t_reached, observer, s, NULL);

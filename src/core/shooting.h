@@ -27,6 +27,7 @@ typedef struct {
   double sc[NW];         /* scale of each unknown */
   double amp_y, amp_psi; /* running maxima during an integration */
   size_t n_shots;        /* integrations so far */
+  size_t n_steps;        /* their integration steps (accepted and rejected) */
 } hm_sh;
 
 /* One evaluation of the shooting map. */

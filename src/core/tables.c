@@ -206,21 +206,28 @@ static hm_status curve_at(const hm_vehicle *veh, const hm_table_spec *spec, doub
   o.shoot.atol = spec->rtol * 1e-3;
   enum { CAP = 20000 };
   hm_cycle_point *pts = malloc(CAP * sizeof *pts);
-  tpoint *tp = malloc(CAP * sizeof *tp);
-  hm_cycle_event ev[64];
+  enum { MAX_EV = 64 };
+  tpoint *tp = malloc((CAP + MAX_EV + 1) * sizeof *tp);
+  hm_cycle_event ev[MAX_EV];
   size_t np = 0, ne = 0;
   if (!pts || !tp) st = HM_ENOMEM;
-  if (st == HM_OK) st = hm_cycles_continue(&v, 500.0, &h, &o, pts, CAP, &np, ev, 64, &ne, NULL);
-  if (st == HM_OK) {
-    double lowest = h.speed_kmh;
+  if (st == HM_OK) st = hm_cycles_continue(&v, 500.0, &h, &o, pts, CAP, &np, ev, MAX_EV, &ne, NULL);
+  if (st == HM_OK && np > 0) {
+    const double lowest = fmin(h.speed_kmh, hm_cycles_lowest(pts, np, ev, ne));
+    /* the polyline: the Hopf point itself (amplitude 0), then the branch with its located folds as vertices (a
+     * fold between two points is the branch's extreme there; flagged stable, each segment beside it takes the
+     * stability of its other end) */
+    size_t m = 0, k = 0;
+    tp[m++] = (tpoint){h.speed_kmh, 0.0, pts[0].stable};
     for (size_t i = 0; i < np; ++i) {
-      tp[i] = (tpoint){pts[i].param, pts[i].amp_y_m, pts[i].stable};
-      lowest = fmin(lowest, pts[i].param);
+      for (; k < ne; ++k) {
+        if (ev[k].index > i) break;
+        if (ev[k].kind == HM_CYCLE_LPC && ev[k].index == i && i > 0)
+          tp[m++] = (tpoint){ev[k].point.param, ev[k].point.amp_y_m, 1};
+      }
+      tp[m++] = (tpoint){pts[i].param, pts[i].amp_y_m, pts[i].stable};
     }
-    /* start the polyline at the Hopf point itself (amplitude 0) */
-    memmove(tp + 1, tp, np * sizeof *tp);
-    tp[0] = (tpoint){h.speed_kmh, 0.0, tp[1].stable};
-    const size_t kept = decimate(tp, np + 1);
+    const size_t kept = decimate(tp, m);
     tpoint *shrunk = realloc(tp, kept * sizeof *tp);
     if (shrunk) tp = shrunk;
     *out = (tcurve){conicity, h.speed_kmh, h.l1, lowest, kept, tp};

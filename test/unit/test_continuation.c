@@ -110,7 +110,8 @@ static void circle(void) {
     worst_t = fmax(worst_t, hypot(p.nodes[i].head.t[0] + y, p.nodes[i].head.t[1] - x));
   }
   HM_CHECK(worst_res < 1e-9, "distance from the circle %g", worst_res);
-  HM_CHECK(worst_t < 1e-8, "tangent off (-y, x) by %g", worst_t);
+  /* the tangent comes from the last evaluation, within the last Newton update (~sqrt(newton_tol)) of the point */
+  HM_CHECK(worst_t < 1e-6, "tangent off (-y, x) by %g", worst_t);
   HM_CHECK(p.max_turn_cos_violation >= o.min_tangent_cos, "a step turned the tangent by acos(%g)",
            p.max_turn_cos_violation);
   HM_CHECK(cur.head.u[0] < p.stop_x && cur.head.u[1] > 0.0, "ended at (%g, %g)", cur.head.u[0], cur.head.u[1]);
@@ -123,7 +124,7 @@ static void circle(void) {
     const pnode *a = &p.nodes[k], *b = &p.nodes[k + 1];
     const double ds = (b->head.u[0] - a->head.u[0]) * a->head.t[0] + (b->head.u[1] - a->head.u[1]) * a->head.t[1];
     pnode fold;
-    HM_CHECK(hm_cont_locate(&p.prob, &o, a, ds, a->head.t[0], b->head.t[0], dx_ds, NULL, &fold) == HM_OK, "locate");
+    HM_CHECK(hm_cont_locate(&p.prob, &o, a, b, ds, a->head.t[0], b->head.t[0], dx_ds, NULL, &fold) == HM_OK, "locate");
     HM_CHECK_DELTA(fold.head.u[0], 1.0, 1e-12, "fold x");
     HM_CHECK_DELTA(fold.head.u[1], 0.0, 1e-8, "fold y");
   }

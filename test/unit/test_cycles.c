@@ -52,9 +52,19 @@ static size_t cycles_at(const family *f, double p, double *amp, int *stable, siz
   for (size_t i = 1; i < f->np && n < max; ++i) {
     const hm_cycle_point *a = &f->pts[i - 1], *b = &f->pts[i];
     if ((a->param - p) * (b->param - p) > 0.0 || a->param == b->param) continue;
+    /* the cycle at exactly p by Newton from the chord between the bracketing branch points */
     const double t = (p - a->param) / (b->param - a->param);
-    amp[n] = a->amp_y_m + t * (b->amp_y_m - a->amp_y_m);
-    stable[n] = a->stable && b->stable;
+    double x0[4];
+    for (int k = 0; k < 4; ++k) x0[k] = a->x0[k] + t * (b->x0[k] - a->x0[k]);
+    hm_cycle_options o;
+    hm_cycle_options_default(&o, HM_PARAM_SPEED);
+    o.shoot.rtol = 1e-10;
+    o.shoot.atol = 1e-13;
+    hm_cycle_point c;
+    HM_CHECK(hm_cycle_solve(&f->veh, 500.0, &o, p, x0, a->period_s + t * (b->period_s - a->period_s), &c) == HM_OK,
+             "cycle at %g between branch points %zu and %zu", p, i - 1, i);
+    amp[n] = c.amp_y_m;
+    stable[n] = c.stable;
     ++n;
   }
   for (size_t i = 1; i < n; ++i) /* sort by amplitude */
@@ -124,7 +134,7 @@ static double simulate_amplitude(const hm_vehicle *veh, const double *x0, double
   hm_dopri d = hm_dopri_create(4);
   double x[4];
   memcpy(x, x0, sizeof x);
-  const hm_dopri_options o = {1e-10, 1e-13, 0.0, 0.0, 0};
+  const hm_dopri_options o = {1e-10, 1e-13, 0.0, 0.0, 0, 0};
   HM_CHECK(hm_dopri_integrate(d, &sys, &o, 0.0, t_end, x, NULL, NULL, NULL, NULL) == HM_OK, "settle");
   /* then the largest |y| over one more second */
   double amp = 0.0;
@@ -204,7 +214,7 @@ static void fold_brute_force(void) {
     hm_dopri d = hm_dopri_create(4);
     double x[4];
     memcpy(x, x0, sizeof x);
-    const hm_dopri_options dop = {1e-10, 1e-13, 0.0, 0.0, 0};
+    const hm_dopri_options dop = {1e-10, 1e-13, 0.0, 0.0, 0, 0};
     HM_CHECK(hm_dopri_integrate(d, &sys, &dop, 0.0, 150.0, x, NULL, NULL, NULL, NULL) == HM_OK, "simulate");
     double amp = 0.0;
     for (int k = 0; k < 200; ++k) {
@@ -276,6 +286,9 @@ static void default_vehicle_whole_family(void) {
     HM_CHECK_DELTA(c->point.amp_y_m, 10.4e-3, 0.05e-3, "third fold amplitude");
     HM_CHECK_DELTA(p->point.param, 261.0, 1.0, "first branch point");
     HM_CHECK_DELTA(q->point.param, 304.0, 2.0, "second branch point");
+    /* the lowest speed with a cycle is the third fold itself (MODEL.md: 239.5), not the nearest branch point */
+    HM_CHECK(hm_cycles_lowest(f.pts, f.np, f.ev, f.ne) == c->point.param, "lowest %.6f is not the fold %.6f",
+             hm_cycles_lowest(f.pts, f.np, f.ev, f.ne), c->point.param);
   }
   /* the unstable cycle beyond LPC2 at lower speeds: about 7.2 mm at 504.5, 8.2 at 420, 9.2 mm at 293 km/h */
   const double v[3] = {504.5, 420.0, 293.0}, ref[3] = {7.2e-3, 8.2e-3, 9.2e-3};

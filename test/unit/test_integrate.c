@@ -44,7 +44,7 @@ static double dopri_fixed_step_error(const hm_ode_system *sys, double T, double 
   hm_dopri d = hm_dopri_create(sys->dim);
   double x[2];
   memcpy(x, x0, sys->dim * sizeof(double));
-  const hm_dopri_options opt = {1e10, 1e10, h, h, 0};
+  const hm_dopri_options opt = {1e10, 1e10, h, h, 0, 0};
   hm_dopri_stats st;
   HM_CHECK(hm_dopri_integrate(d, sys, &opt, 0.0, T, x, NULL, NULL, NULL, &st) == HM_OK, "integrate");
   HM_CHECK(st.n_rejected == 0, "fixed-step run rejected %zu steps", st.n_rejected);
@@ -87,7 +87,7 @@ static void dopri_error_control_tracks_tolerance(void) {
   const double tols[] = {1e-6, 1e-8, 1e-10};
   for (int i = 0; i < 3; ++i) {
     double x[2] = {1.0, 0.0};
-    const hm_dopri_options opt = {tols[i], tols[i], 0.0, 0.0, 0};
+    const hm_dopri_options opt = {tols[i], tols[i], 0.0, 0.0, 0, 0};
     HM_CHECK(hm_dopri_integrate(d, &osc, &opt, 0.0, T, x, NULL, NULL, NULL, NULL) == HM_OK, "integrate");
     errs[i] = fmax(fabs(x[0] - cos(T)), fabs(x[1] + sin(T)));
   }
@@ -128,7 +128,7 @@ static void dopri_dense_output_and_observer(void) {
   const hm_ode_system osc = {2, osc_rhs, NULL, NULL};
   hm_dopri d = hm_dopri_create(2);
   double x[2] = {1.0, 0.0}, t_end;
-  const hm_dopri_options opt = {1e-9, 1e-9, 0.0, 0.0, 0};
+  const hm_dopri_options opt = {1e-9, 1e-9, 0.0, 0.0, 0, 0};
   dense_ctx c = {0.0, 0};
   HM_CHECK(hm_dopri_integrate(d, &osc, &opt, 0.0, 20.0, x, &t_end, dense_observer, &c, NULL) == HM_OK, "run");
   printf("  dense output worst error %.2e over %d steps\n", c.worst, c.calls);
@@ -142,6 +142,34 @@ static void dopri_dense_output_and_observer(void) {
   hm_dopri_destroy(d);
 }
 
+/* The oscillator plus a rapidly decaying, uncontrolled passenger z' = -30 z (components 2, 3 = two copies): with
+ * err_dim 2 the steps are those of the oscillator integrated alone (the reference run), with all components under
+ * control the stiff-ish passenger takes more; the oscillator's solution stays within its tolerance. */
+static hm_status osc_passenger_rhs(double t, const double *x, double *dx, void *p) {
+  osc_rhs(t, x, dx, p);
+  dx[2] = -30.0 * x[2];
+  dx[3] = -30.0 * x[3];
+  return HM_OK;
+}
+
+static void dopri_error_control_on_leading_components(void) {
+  const hm_ode_system osc = {2, osc_rhs, NULL, NULL}, both = {4, osc_passenger_rhs, NULL, NULL};
+  hm_dopri d2 = hm_dopri_create(2), d4 = hm_dopri_create(4);
+  const hm_dopri_options all = {1e-10, 1e-10, 0.0, 0.0, 0, 0}, lead = {1e-10, 1e-10, 0.0, 0.0, 0, 2};
+  double x[2] = {1.0, 0.0}, y[4] = {1.0, 0.0, 1.0, 1.0}, w[4] = {1.0, 0.0, 1.0, 1.0};
+  hm_dopri_stats s2, s4, sa;
+  HM_CHECK(hm_dopri_integrate(d2, &osc, &all, 0.0, 10.0, x, NULL, NULL, NULL, &s2) == HM_OK, "alone");
+  HM_CHECK(hm_dopri_integrate(d4, &both, &lead, 0.0, 10.0, y, NULL, NULL, NULL, &s4) == HM_OK, "leading");
+  HM_CHECK(hm_dopri_integrate(d4, &both, &all, 0.0, 10.0, w, NULL, NULL, NULL, &sa) == HM_OK, "all");
+  printf("  steps: oscillator alone %zu, leading components %zu, all components %zu\n", s2.n_accepted,
+         s4.n_accepted, sa.n_accepted);
+  HM_CHECK(s4.n_accepted == s2.n_accepted && s4.n_rejected == s2.n_rejected, "not the oscillator's steps");
+  HM_CHECK(sa.n_accepted > s2.n_accepted, "the passenger under control took no more steps");
+  HM_CHECK_DELTA(y[0], cos(10.0), 1e-8, "oscillator");
+  hm_dopri_destroy(d2);
+  hm_dopri_destroy(d4);
+}
+
 /* Variational equations of the oscillator: Phi(t) = [[cos t, sin t], [-sin t, cos t]]. */
 static void variational_matrix_is_the_rotation(void) {
   const hm_ode_system osc = {2, osc_rhs, osc_jac, NULL};
@@ -150,7 +178,7 @@ static void variational_matrix_is_the_rotation(void) {
   const hm_ode_system vsys = {6, hm_variational_rhs, NULL, &var};
   hm_dopri d = hm_dopri_create(6);
   double z[6] = {1.0, 0.0, 1.0, 0.0, 0.0, 1.0}; /* x, then columns of Phi = I */
-  const hm_dopri_options opt = {1e-11, 1e-12, 0.0, 0.0, 0};
+  const hm_dopri_options opt = {1e-11, 1e-12, 0.0, 0.0, 0, 0};
   const double T = 2.5;
   HM_CHECK(hm_dopri_integrate(d, &vsys, &opt, 0.0, T, z, NULL, NULL, NULL, NULL) == HM_OK, "run");
   HM_CHECK_DELTA(z[2], cos(T), 1e-9, "Phi00");
@@ -200,10 +228,10 @@ static void integrator_bad_inputs(void) {
   const hm_ode_system osc = {2, osc_rhs, osc_jac, NULL}, bad = {1, nan_after_one, NULL, NULL};
   hm_dopri d = hm_dopri_create(2), d1 = hm_dopri_create(1);
   double x[2] = {1.0, 0.0};
-  const hm_dopri_options opt = {1e-9, 1e-9, 0.0, 0.0, 0};
+  const hm_dopri_options opt = {1e-9, 1e-9, 0.0, 0.0, 0, 0};
   HM_CHECK(hm_dopri_create(0) == NULL, "zero dimension");
   HM_CHECK(hm_dopri_integrate(d, &osc, &opt, 1.0, 0.0, x, NULL, NULL, NULL, NULL) == HM_EINVAL, "t1 < t0");
-  const hm_dopri_options neg = {-1.0, 1e-9, 0.0, 0.0, 0};
+  const hm_dopri_options neg = {-1.0, 1e-9, 0.0, 0.0, 0, 0};
   HM_CHECK(hm_dopri_integrate(d, &osc, &neg, 0.0, 1.0, x, NULL, NULL, NULL, NULL) == HM_EINVAL, "rtol < 0");
   double xn[2] = {NAN, 0.0};
   HM_CHECK(hm_dopri_integrate(d, &osc, &opt, 0.0, 1.0, xn, NULL, NULL, NULL, NULL) == HM_ENONFINITE, "NaN state");
@@ -211,7 +239,7 @@ static void integrator_bad_inputs(void) {
   const hm_status st = hm_dopri_integrate(d1, &bad, &opt, 0.0, 2.0, y, NULL, NULL, NULL, NULL);
   HM_CHECK(st == HM_ENONFINITE, "NaN right-hand side: %s", hm_status_str(st));
   HM_CHECK(y[0] == 1.0, "state changed on failure");
-  const hm_dopri_options few = {1e-12, 1e-12, 0.0, 0.0, 5};
+  const hm_dopri_options few = {1e-12, 1e-12, 0.0, 0.0, 5, 0};
   HM_CHECK(hm_dopri_integrate(d, &osc, &few, 0.0, 100.0, x, NULL, NULL, NULL, NULL) == HM_ESTEP, "step limit");
   HM_CHECK(x[0] == 1.0 && x[1] == 0.0, "state changed on failure");
   HM_CHECK(hm_dopri_integrate(d1, &osc, &opt, 0.0, 1.0, x, NULL, NULL, NULL, NULL) == HM_EINVAL, "dim mismatch");
@@ -228,6 +256,7 @@ int main(void) {
   HM_RUN(dopri_convergence_order_is_five);
   HM_RUN(dopri_error_control_tracks_tolerance);
   HM_RUN(dopri_dense_output_and_observer);
+  HM_RUN(dopri_error_control_on_leading_components);
   HM_RUN(variational_matrix_is_the_rotation);
   HM_RUN(midpoint_order_two_and_invariant);
   HM_RUN(integrator_bad_inputs);
