@@ -50,8 +50,20 @@ typedef struct {
 /* Defaults: conicity 0.05..0.40 (15 points), speeds 150..700 km/h, cycles up to 16 mm, rtol 1e-10. */
 void hm_table_spec_default(hm_table_spec *spec);
 
-/* Compute a table (about 2 continuations per grid point; seconds). */
+/* One unit of work of a parallel loop: index i of [0, n). */
+typedef void (*hm_job_fn)(void *ctx, size_t i);
+/* Runs job(ctx, i) for every i in [0, n), in any order and possibly at the same time on several threads, and
+ * returns when all are done. The core has no threads of its own: the caller supplies this (threads.h has one
+ * over POSIX threads). */
+typedef void (*hm_parallel_for_fn)(void *runner, size_t n, hm_job_fn job, void *ctx);
+
+/* Compute a table: a cycle family per grid conicity and per midpoint between them (the midpoints measure the
+ * interpolation error), 2 n - 1 continuations of about 20-60 ms each. hm_table_build runs them in order on the
+ * calling thread; hm_table_build_parallel hands them to pfor(runner, ...) (the families are independent; the
+ * result is the same). */
 hm_status hm_table_build(const hm_vehicle *veh, const hm_table_spec *spec, hm_table *out);
+hm_status hm_table_build_parallel(const hm_vehicle *veh, const hm_table_spec *spec, hm_parallel_for_fn pfor,
+                                  void *runner, hm_table *out);
 
 /* Serialise into buf (len bytes); *needed gets the full size including the terminating NUL. HM_EINVAL if
  * len is too small (then call again with *needed bytes). */

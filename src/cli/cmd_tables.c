@@ -6,6 +6,7 @@
 
 #include "cli.h"
 #include "hunting_monitor/tables.h"
+#include "hunting_monitor/threads.h"
 
 const cli_option tables_opts[] = {
     {"out", "FILE", "write the table there (required)"},
@@ -15,6 +16,7 @@ const cli_option tables_opts[] = {
     {"v-min", "KM/H", "lowest speed followed (default 150)"},
     {"v-max", "KM/H", "highest speed of interest (default 700)"},
     {"amp-max", "M", "largest cycle amplitude followed (default 0.016 m)"},
+    {"threads", "N", "threads computing the families (default 0: one per processor)"},
     CLI_VEHICLE_OPTIONS,
     {NULL, NULL, NULL}};
 
@@ -22,13 +24,17 @@ int cmd_tables(const cli_args *a) {
   hm_vehicle veh;
   hm_table_spec spec;
   hm_table_spec_default(&spec);
-  double n_d = (double)spec.n_conicity;
+  double n_d = (double)spec.n_conicity, threads_d = 0.0;
   const char *path = cli_value(a, "out");
   if (cli_vehicle(a, &veh, NULL) || cli_number(a, "conicity-min", &spec.conicity_min) ||
       cli_number(a, "conicity-max", &spec.conicity_max) || cli_number(a, "n", &n_d) ||
       cli_number(a, "v-min", &spec.speed_min_kmh) || cli_number(a, "v-max", &spec.speed_max_kmh) ||
-      cli_number(a, "amp-max", &spec.amp_max_m))
+      cli_number(a, "amp-max", &spec.amp_max_m) || cli_number(a, "threads", &threads_d))
     return 1;
+  if (!(threads_d >= 0 && threads_d <= 64) || threads_d != (double)(unsigned)threads_d) {
+    fprintf(stderr, "hunting tables: --threads must be an integer in 0..64\n");
+    return 1;
+  }
   if (!path) {
     fprintf(stderr, "hunting tables: --out FILE is required\n");
     return 1;
@@ -41,7 +47,8 @@ int cmd_tables(const cli_args *a) {
   struct timespec t0, t1;
   timespec_get(&t0, TIME_UTC);
   hm_table t = NULL;
-  hm_status st = hm_table_build(&veh, &spec, &t);
+  hm_threads threads = {(unsigned)threads_d};
+  hm_status st = hm_table_build_parallel(&veh, &spec, hm_threads_parallel_for, &threads, &t);
   if (st == HM_EINVAL) {
     fprintf(stderr, "hunting tables: need 0 < --conicity-min < --conicity-max, 0 < --v-min < --v-max <= %g, "
                     "0.001 < --amp-max <= 0.1\n", HM_TABLE_MAX_SPEED_KMH);

@@ -287,28 +287,60 @@ hm_status hm_table_check_vehicle(const hm_table t, const hm_vehicle *veh, double
   return HM_OK;
 }
 
-hm_status hm_table_build(const hm_vehicle *veh, const hm_table_spec *spec, hm_table *out) {
+/* The families of a build: grid curves 0..n-1, then midpoints n..2n-2; each job fills its own slot. */
+typedef struct {
+  const hm_vehicle *veh;
+  const hm_table_spec *spec;
+  tcurve *curves;
+  hm_status *status;
+  size_t n;
+} build_ctx;
+
+static void build_job(void *ctx, size_t i) {
+  build_ctx *b = (build_ctx *)ctx;
+  const double dc = (b->spec->conicity_max - b->spec->conicity_min) / (double)(b->n - 1);
+  const double at = i < b->n ? (double)i : (double)(i - b->n) + 0.5;
+  b->status[i] = curve_at(b->veh, b->spec, b->spec->conicity_min + dc * at, &b->curves[i]);
+}
+
+static void run_in_order(void *runner, size_t n, hm_job_fn job, void *ctx) {
+  (void)runner;
+  for (size_t i = 0; i < n; ++i) job(ctx, i);
+}
+
+hm_status hm_table_build_parallel(const hm_vehicle *veh, const hm_table_spec *spec, hm_parallel_for_fn pfor,
+                                  void *runner, hm_table *out) {
   if (!veh || !spec || !out || !spec_valid(spec)) return HM_EINVAL;
   hm_status st = hm_vehicle_validate(veh, NULL, 0);
   if (st != HM_OK) return st;
-  hm_table t = hm_table_alloc(spec->n_conicity);
-  if (!t) return HM_ENOMEM;
+  const size_t n = spec->n_conicity, jobs = 2 * n - 1;
+  hm_table t = hm_table_alloc(n);
+  tcurve *curves = calloc(jobs, sizeof *curves);
+  hm_status *status = malloc(jobs * sizeof *status);
+  if (!t || !curves || !status) {
+    hm_table_destroy(t);
+    free(curves);
+    free(status);
+    return HM_ENOMEM;
+  }
+  for (size_t i = 0; i < jobs; ++i) status[i] = HM_EINVAL; /* a job the runner skipped fails the build */
+  build_ctx b = {veh, spec, curves, status, n};
+  (pfor ? pfor : run_in_order)(runner, jobs, build_job, &b);
+  for (size_t i = 0; i < jobs && st == HM_OK; ++i) st = status[i];
   t->kx_mn_m = veh->stiffness_long_n_m / 1e6;
   t->ky_mn_m = veh->stiffness_lat_n_m / 1e6;
   t->speed_min_kmh = spec->speed_min_kmh;
   t->speed_max_kmh = spec->speed_max_kmh;
   t->amp_max_m = spec->amp_max_m;
-  const double dc = (spec->conicity_max - spec->conicity_min) / (double)(spec->n_conicity - 1);
-  for (size_t i = 0; i < t->n && st == HM_OK; ++i) st = curve_at(veh, spec, spec->conicity_min + dc * (double)i, &t->curves[i]);
-  double e_hopf = 0.0, e_low = 0.0, e_amp = 0.0;
-  for (size_t i = 0; i + 1 < t->n && st == HM_OK; ++i) {
-    tcurve mid;
-    st = curve_at(veh, spec, spec->conicity_min + dc * ((double)i + 0.5), &mid);
-    if (st == HM_OK) {
-      midpoint_errors(t, &mid, &e_hopf, &e_low, &e_amp);
-      free(mid.pts);
-    }
+  for (size_t i = 0; i < n; ++i) { /* the table owns the grid curves (freed with it, built or not) */
+    t->curves[i] = curves[i];
+    curves[i].pts = NULL;
   }
+  double e_hopf = 0.0, e_low = 0.0, e_amp = 0.0;
+  for (size_t i = n; i < jobs && st == HM_OK; ++i) midpoint_errors(t, &curves[i], &e_hopf, &e_low, &e_amp);
+  for (size_t i = n; i < jobs; ++i) free(curves[i].pts);
+  free(curves);
+  free(status);
   if (st != HM_OK) {
     hm_table_destroy(t);
     return st;
@@ -318,6 +350,10 @@ hm_status hm_table_build(const hm_vehicle *veh, const hm_table_spec *spec, hm_ta
   t->err_amp_m = e_amp;
   *out = t;
   return HM_OK;
+}
+
+hm_status hm_table_build(const hm_vehicle *veh, const hm_table_spec *spec, hm_table *out) {
+  return hm_table_build_parallel(veh, spec, NULL, NULL, out);
 }
 
 /* ---- text format ---- */

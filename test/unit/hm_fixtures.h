@@ -4,7 +4,7 @@
 
 #include "hunting_monitor/tables.h"
 
-/* The boundary table of the default vehicle over lambda(0) 0.12..0.16 (3 conicities; about 2 s). */
+/* The boundary table of the default vehicle over lambda(0) 0.12..0.16 (3 conicities; about 0.1 s). */
 static inline hm_status hm_test_small_table(hm_table *table) {
   hm_vehicle v;
   hm_vehicle_default(&v);

@@ -7,6 +7,7 @@
 #include "hunting_monitor/cycles.h"
 #include "hunting_monitor/linear.h"
 #include "hunting_monitor/tables.h"
+#include "hunting_monitor/threads.h"
 
 static hm_table table;
 static hm_vehicle vehicle;
@@ -203,6 +204,42 @@ static void table_checked_against_vehicle(void) {
   free(text);
 }
 
+static char *format(const hm_table t) {
+  size_t len = 0;
+  hm_table_format(t, NULL, 0, &len);
+  char *text = malloc(len);
+  if (text && hm_table_format(t, text, len, &len) != HM_OK) text[0] = 0;
+  return text;
+}
+
+/* A runner that forgets the last job: the build must fail, not return a table with a hole. */
+static void skip_last(void *runner, size_t n, hm_job_fn job, void *ctx) {
+  (void)runner;
+  for (size_t i = 0; i + 1 < n; ++i) job(ctx, i);
+}
+
+/* The families built on 1, 2 and 3 threads make the same table as the sequential build, byte for byte. */
+static void parallel_build_equals_sequential(void) {
+  hm_table_spec spec;
+  hm_table_spec_default(&spec);
+  spec.conicity_min = 0.12;
+  spec.conicity_max = 0.16;
+  spec.n_conicity = 3;
+  char *ref = format(table);
+  for (unsigned k = 1; k <= 3; ++k) {
+    hm_threads threads = {k};
+    hm_table t = NULL;
+    HM_CHECK(hm_table_build_parallel(&vehicle, &spec, hm_threads_parallel_for, &threads, &t) == HM_OK, "build");
+    char *text = t ? format(t) : NULL;
+    HM_CHECK(ref && text && strcmp(ref, text) == 0, "%u threads: table differs from the sequential build", k);
+    free(text);
+    hm_table_destroy(t);
+  }
+  hm_table t = NULL;
+  HM_CHECK(hm_table_build_parallel(&vehicle, &spec, skip_last, NULL, &t) == HM_EINVAL && t == NULL, "skipped job");
+  free(ref);
+}
+
 int main(void) {
   hm_vehicle_default(&vehicle);
   if (hm_test_small_table(&table) != HM_OK) {
@@ -214,6 +251,7 @@ int main(void) {
   HM_RUN(round_trip);
   HM_RUN(malformed_tables);
   HM_RUN(table_checked_against_vehicle);
+  HM_RUN(parallel_build_equals_sequential);
   hm_table_destroy(table);
   HM_TEST_EXIT();
 }
