@@ -37,21 +37,23 @@ typedef struct {
 } hm_shooting_options;
 
 /*
- * Pseudo-arclength continuation, shared by cycle families and LPC curves: predictor along the unit tangent,
- * Newton's corrector orthogonal to it (an update above 50 scaled units counts as divergence), then step control.
+ * Pseudo-arclength continuation, shared by cycle families and LPC curves: predictor along the unit tangent (plus,
+ * with curvature_predictor, half the step squared times the curvature vector estimated from the last two
+ * tangents, (t_k - t_k-1) / ds), Newton's corrector orthogonal to the tangent (an update above 50 scaled units counts as divergence), then step control.
  * Newton has converged when its update, or the error left after it as estimated from the last two updates
  * (d_k^2 / d_(k-1), the linear-convergence bound), is below newton_tol. A step is rejected and retried at half
  * the length (down to ds_min) when the corrector fails, lands farther than max(|ds|, jump_floor) from the
  * predictor (a jump to another branch) or turns the tangent by more than acos(min_tangent_cos). After an accepted
- * step, with predictor_tol > 0, ds is scaled by sqrt(predictor_tol / e) within [shrink_factor, grow_factor], e the
- * distance from predictor to corrector (the predictor's error grows as ds^2): few points where the branch is
- * straight, many where it bends. With predictor_tol = 0, ds grows by grow_factor when Newton needed at most
+ * step, with predictor_tol > 0, ds is scaled by (predictor_tol / e)^(1/q) within [shrink_factor, grow_factor], e the
+ * distance from predictor to corrector, whose error grows as ds^q (q = 2 for the tangent, 3 with the curvature):
+ * few points where the branch is straight, many where it bends. With predictor_tol = 0, ds grows by grow_factor when Newton needed at most
  * fast_newton_iters iterations and shrinks by shrink_factor when it needed slow_newton_iters or more.
  */
 typedef struct {
   double ds_init, ds_min, ds_max; /* arclength steps (scaled units, see above): 0.2, 1e-4, 20 */
   size_t max_steps;         /* step attempts, accepted or rejected (per direction for LPC curves) */
   double predictor_tol;     /* 0.03 scaled units (30 um or 0.03 km/h); 0: step control by Newton iterations */
+  int curvature_predictor;  /* 1 (default): the second-order predictor above; 0: the tangent only */
   double min_tangent_cos;   /* cycles 0.95; LPC curves 0.9 (their fold row makes the tangent noisier) */
   int fast_newton_iters;    /* (predictor_tol = 0) cycles 2; LPC curves 3 (their fold-test row is a chord) */
   int slow_newton_iters;    /* (predictor_tol = 0) cycles 5; LPC curves 6 */

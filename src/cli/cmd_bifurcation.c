@@ -123,7 +123,7 @@ const cli_option cycles_opts[] = {
     {"to", "VALUE", "other parameters: upper end"},
     {"amp-max", "M", "stop when max|y| exceeds this (default 0.020 m)"},
     {"ds-max", "S", "largest continuation step, scaled units (default 5)"},
-    {"rtol", "R", "shooting integration tolerance (default 1e-10)"},
+    {"rtol", "R", "shooting integration tolerance (default 1e-9)"},
     {"refine", NULL, "repeat with 100x tighter tolerances and 4x smaller steps; report which points persist"},
     {"csv", NULL, "write the branch as CSV instead of JSON"},
     {"out", "FILE", "write the output there instead of stdout"},
@@ -305,7 +305,8 @@ int cmd_cycles(const cli_args *a) {
     of.shoot.atol *= 1e-2;
     of.cont.ds_max *= 0.25;
     of.cont.ds_init *= 0.25;
-    of.cont.predictor_tol /= 16.0; /* 4x smaller steps where the predictor's error sets them */
+    /* 4x smaller steps where the predictor's error (growing as ds^2, or ds^3 with the curvature) sets them */
+    of.cont.predictor_tol /= of.cont.curvature_predictor ? 64.0 : 16.0;
     of.cont.max_steps *= 4;
     rc = run_family(&veh, speed, &hopf, &of, &fine);
   }

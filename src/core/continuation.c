@@ -33,6 +33,7 @@ void hm_cont_options_default(hm_cont_options *o) {
   o->shrink_factor = 0.7;
   o->jump_floor = 0.05;
   o->predictor_tol = 0.03;
+  o->curvature_predictor = 1;
   o->newton_tol = 1e-9;
   o->newton_max_iter = 8;
   o->locate_tol = 1e-9;
@@ -42,7 +43,8 @@ int hm_cont_options_valid(const hm_cont_options *o) {
   return o && o->ds_min > 0.0 && o->ds_init >= o->ds_min && o->ds_max >= o->ds_init && isfinite(o->ds_max) &&
          o->max_steps > 0 && o->min_tangent_cos > 0.0 && o->min_tangent_cos < 1.0 && o->fast_newton_iters >= 1 &&
          o->slow_newton_iters > o->fast_newton_iters && o->grow_factor >= 1.0 && isfinite(o->grow_factor) &&
-         o->shrink_factor > 0.0 && o->shrink_factor <= 1.0 && o->jump_floor >= 0.0 && o->predictor_tol >= 0.0 && isfinite(o->predictor_tol) && o->newton_tol > 0.0 &&
+         o->shrink_factor > 0.0 && o->shrink_factor <= 1.0 && o->jump_floor >= 0.0 && o->predictor_tol >= 0.0 && isfinite(o->predictor_tol) &&
+         (o->curvature_predictor == 0 || o->curvature_predictor == 1) && o->newton_tol > 0.0 &&
          o->newton_max_iter > 0 && o->locate_tol > 0.0;
 }
 
@@ -111,13 +113,13 @@ hm_status hm_cont_correct(hm_cont_problem *p, const hm_cont_options *o, double *
 /* The step from a of length sigma; Newton starts from the predictor, or, given a point `near` on the branch that
  * satisfies the arclength condition at near_sigma, from near moved along a's tangent to sigma (event location). */
 static hm_status cont_step(hm_cont_problem *p, const hm_cont_options *o, const void *a, double sigma, void *out,
-                           int *iters, double *pred_err, const double *near, double near_sigma) {
+                           int *iters, double *pred_err, const double *near, double near_sigma, const double *kappa) {
   const hm_cont_point *pa = (const hm_cont_point *)a;
   const size_t n = p->n;
   double w[MAXN], pred[MAXN], target = 0.0;
   for (size_t j = 0; j < n; ++j) {
-    pred[j] = pa->u[j] + sigma * pa->t[j] * p->scale[j];
-    target += pa->t[j] * pred[j] / p->scale[j];
+    target += pa->t[j] * (pa->u[j] / p->scale[j] + sigma * pa->t[j]);
+    pred[j] = pa->u[j] + (sigma * pa->t[j] + (kappa ? 0.5 * sigma * sigma * kappa[j] : 0.0)) * p->scale[j];
     w[j] = near ? near[j] + (sigma - near_sigma) * pa->t[j] * p->scale[j] : pred[j];
   }
   hm_status st = hm_cont_correct(p, o, w, pa->t, target, pa->t, out, iters);
@@ -132,14 +134,15 @@ static hm_status cont_step(hm_cont_problem *p, const hm_cont_options *o, const v
 
 hm_status hm_cont_step(hm_cont_problem *p, const hm_cont_options *o, const void *a, double sigma, void *out,
                        int *iters) {
-  return cont_step(p, o, a, sigma, out, iters, NULL, NULL, 0.0);
+  return cont_step(p, o, a, sigma, out, iters, NULL, NULL, 0.0, NULL);
 }
 
 hm_cont_stop hm_cont_run(hm_cont_problem *p, const hm_cont_options *o, void *cur, void *scratch,
                          hm_cont_stats *stats) {
   hm_cont_stats s = {HM_CONT_STEP_LIMIT, 0, 0, 0, 0, 0};
   const size_t newton0 = p->newton_iterations;
-  double ds = o->ds_init;
+  double ds = o->ds_init, kappa[MAXN] = {0};
+  int have_kappa = 0;
   for (size_t attempt = 0; attempt < o->max_steps; ++attempt) {
     const int reason = p->stop(p->ctx, cur);
     if (reason != HM_CONT_RUNNING) {
@@ -148,7 +151,7 @@ hm_cont_stop hm_cont_run(hm_cont_problem *p, const hm_cont_options *o, void *cur
     }
     int iters = 0;
     double pred_err = 0.0;
-    hm_status st = cont_step(p, o, cur, ds, scratch, &iters, &pred_err, NULL, 0.0);
+    hm_status st = cont_step(p, o, cur, ds, scratch, &iters, &pred_err, NULL, 0.0, have_kappa ? kappa : NULL);
     double dot = 0.0;
     if (st == HM_OK)
       for (size_t j = 0; j < p->n; ++j) dot += ((hm_cont_point *)scratch)->t[j] * ((hm_cont_point *)cur)->t[j];
@@ -162,11 +165,16 @@ hm_cont_stop hm_cont_run(hm_cont_problem *p, const hm_cont_options *o, void *cur
       continue;
     }
     if (p->accepted) p->accepted(p->ctx, cur, scratch, ds);
+    /* the branch's curvature (scaled) from the tangents at both ends: the next predictor's second-order term */
+    have_kappa = o->curvature_predictor;
+    for (size_t j = 0; j < p->n; ++j)
+      kappa[j] = (((hm_cont_point *)scratch)->t[j] - ((hm_cont_point *)cur)->t[j]) / ds;
     memcpy(cur, scratch, p->node_size);
     ++s.steps;
     if (o->predictor_tol > 0.0) {
-      /* the tangent predictor's error grows as ds^2 */
-      const double f = pred_err > 0.0 ? sqrt(o->predictor_tol / pred_err) : o->grow_factor;
+      /* the predictor's error grows as ds^2 (tangent) or ds^3 (with the curvature) */
+      const double r = pred_err > 0.0 ? o->predictor_tol / pred_err : INFINITY;
+      const double f = have_kappa ? cbrt(r) : sqrt(r);
       ds = fmin(fmax(ds * fmin(fmax(f, o->shrink_factor), o->grow_factor), o->ds_min), o->ds_max);
     } else if (iters <= o->fast_newton_iters) ds = fmin(o->grow_factor * ds, o->ds_max);
     else if (iters >= o->slow_newton_iters) ds = fmax(o->shrink_factor * ds, o->ds_min);
@@ -188,7 +196,7 @@ typedef struct {
 
 static hm_status locate_fn(double sigma, double *value, void *ctx) {
   locate_ctx *l = (locate_ctx *)ctx;
-  hm_status st = cont_step(l->p, l->o, l->a, sigma, l->node, NULL, NULL, l->near, l->near_sigma);
+  hm_status st = cont_step(l->p, l->o, l->a, sigma, l->node, NULL, NULL, l->near, l->near_sigma, NULL);
   if (st == HM_OK) {
     *value = l->test(l->node, l->arg);
     memcpy(l->near, ((const hm_cont_point *)l->node)->u, sizeof l->near);
@@ -204,6 +212,6 @@ hm_status hm_cont_locate(hm_cont_problem *p, const hm_cont_options *o, const voi
   double root;
   hm_status st = hm_brent_root(locate_fn, &l, 0.0, ds, fa, fb, o->locate_tol, 100, &root);
   if (st == HM_OK && root != l.near_sigma) /* else out holds the point found last, at the root */
-    st = cont_step(p, o, a, root, out, NULL, NULL, l.near, l.near_sigma);
+    st = cont_step(p, o, a, root, out, NULL, NULL, l.near, l.near_sigma, NULL);
   return st;
 }
