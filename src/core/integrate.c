@@ -7,6 +7,7 @@
 #include <string.h>
 
 #include "lapack.h"
+#include "rk.h"
 
 hm_status hm_variational_rhs(double t, const double *z, double *dzdt, void *variational) {
   const hm_variational *var = (const hm_variational *)variational;
@@ -27,6 +28,70 @@ hm_status hm_variational_rhs(double t, const double *z, double *dzdt, void *vari
     }
   }
   return HM_OK;
+}
+
+hm_status hm_rk_check(const hm_ode_system *sys, size_t dim, const hm_dopri_options *opt, double t0, double t1,
+                      const double *x) {
+  if (!sys || !opt || !x || !sys->rhs || sys->dim != dim) return HM_EINVAL;
+  if (!isfinite(t0) || !isfinite(t1) || t1 < t0) return HM_EINVAL;
+  if (!(opt->rtol > 0.0) || !(opt->atol >= 0.0) || !isfinite(opt->rtol) || !isfinite(opt->atol)) return HM_EINVAL;
+  for (size_t i = 0; i < dim; ++i)
+    if (!isfinite(x[i])) return HM_ENONFINITE;
+  return HM_OK;
+}
+
+hm_status hm_rk_drive(const hm_rk_method *m, const hm_dopri_options *opt, double t0, double t1, double h,
+                      double *t_reached, hm_dopri_stats *s) {
+  const double h_max = opt->h_max > 0.0 ? fmin(opt->h_max, t1 - t0) : t1 - t0;
+  const size_t max_steps = opt->max_steps ? opt->max_steps : 100000000u;
+  double t = t0;
+  h = fmin(h, h_max);
+  int last_rejected = 0, last_nonfinite = 0;
+  hm_status st = HM_OK;
+  while (t < t1 && st == HM_OK) {
+    if (s->n_accepted + s->n_rejected >= max_steps) {
+      st = HM_ESTEP;
+      break;
+    }
+    if (h < 1e-14 * fmax(1.0, fabs(t))) {
+      st = last_nonfinite ? HM_ENONFINITE : HM_ESTEP;
+      break;
+    }
+    int final_step = 0;
+    if (t + 1.01 * h >= t1) {
+      h = t1 - t;
+      final_step = 1;
+    }
+    double err;
+    st = m->attempt(m->ctx, t, h, &err);
+    s->n_rhs += m->rhs_per_attempt;
+    if (st == HM_ENONFINITE) {
+      err = INFINITY; /* a failed step: retry smaller */
+      st = HM_OK;
+    }
+    if (st != HM_OK) break;
+    last_nonfinite = !isfinite(err);
+    if (err <= 1.0) {
+      const double t_new = final_step ? t1 : t + h;
+      int stop = 0;
+      st = m->accept(m->ctx, t, t_new, h, &stop);
+      s->n_rhs += m->rhs_per_accept;
+      s->n_accepted++;
+      t = t_new;
+      if (stop) break;
+      double fac = err > 0.0 ? 0.9 * pow(err, -m->expo) : m->fac_max;
+      fac = fmin(m->fac_max, fmax(m->fac_min, fac));
+      if (last_rejected) fac = fmin(fac, 1.0);
+      h = fmin(h * fac, h_max);
+      last_rejected = 0;
+    } else {
+      s->n_rejected++;
+      h *= isfinite(err) ? fmax(m->fac_min, 0.9 * pow(err, -m->expo)) : 0.2;
+      last_rejected = 1;
+    }
+  }
+  *t_reached = t;
+  return st;
 }
 
 /* ---- Dormand-Prince 5(4): tableau and Shampine's dense output (Hairer's DOPRI5) ---- */
@@ -188,75 +253,55 @@ static hm_status dopri_initial_step(hm_dopri d, const hm_ode_system *sys, const 
   return HM_OK;
 }
 
+typedef struct {
+  hm_dopri d;
+  const hm_ode_system *sys;
+  const hm_dopri_options *opt;
+  hm_dopri_observer observer;
+  void *ctx;
+} dopri_run;
+
+static hm_status dopri_attempt(void *ctx, double t, double h, double *err) {
+  dopri_run *r = (dopri_run *)ctx;
+  hm_status st = dopri_try(r->d, r->sys, t, h);
+  if (st == HM_OK) *err = dopri_error_norm(r->d, r->opt->rtol, r->opt->atol, r->opt->err_dim);
+  return st;
+}
+
+static hm_status dopri_accept(void *ctx, double t_old, double t_new, double h, int *stop) {
+  dopri_run *r = (dopri_run *)ctx;
+  hm_dopri d = r->d;
+  dopri_store_dense(d, t_old, h);
+  memcpy(d->x, d->xnew, d->dim * sizeof(double));
+  memcpy(d->k1, d->k7, d->dim * sizeof(double)); /* first same as last */
+  *stop = r->observer && r->observer(d, t_old, t_new, d->x, r->ctx);
+  return HM_OK;
+}
+
 hm_status hm_dopri_integrate(hm_dopri d, const hm_ode_system *sys, const hm_dopri_options *opt, double t0,
                              double t1, double *x, double *t_end, hm_dopri_observer observer, void *ctx,
                              hm_dopri_stats *stats) {
-  if (!d || !sys || !opt || !x || !sys->rhs || sys->dim != d->dim) return HM_EINVAL;
-  if (!isfinite(t0) || !isfinite(t1) || t1 < t0) return HM_EINVAL;
-  if (!(opt->rtol > 0.0) || !(opt->atol >= 0.0) || !isfinite(opt->rtol) || !isfinite(opt->atol)) return HM_EINVAL;
-  const size_t n = d->dim;
-  for (size_t i = 0; i < n; ++i)
-    if (!isfinite(x[i])) return HM_ENONFINITE;
+  if (!d) return HM_EINVAL;
+  hm_status st = hm_rk_check(sys, d->dim, opt, t0, t1, x);
+  if (st != HM_OK) return st;
   hm_dopri_stats s = {0, 0, 0};
-  memcpy(d->x, x, n * sizeof(double));
+  memcpy(d->x, x, d->dim * sizeof(double));
   d->have_dense = 0;
   double t = t0;
-  if (t1 == t0) {
-    if (t_end) *t_end = t0;
-    if (stats) *stats = s;
-    return HM_OK;
-  }
-  const double h_max = opt->h_max > 0.0 ? fmin(opt->h_max, t1 - t0) : t1 - t0;
-  const size_t max_steps = opt->max_steps ? opt->max_steps : 100000000u;
-  hm_status st = sys->rhs(t, d->x, d->k1, sys->params);
-  if (st != HM_OK) return st;
-  s.n_rhs = 1;
-  double h = opt->h_init > 0.0 ? fmin(opt->h_init, h_max) : 0.0;
-  if (h == 0.0) {
-    if ((st = dopri_initial_step(d, sys, opt, t, h_max, &h)) != HM_OK) return st;
-    s.n_rhs++;
-  }
-  int last_rejected = 0, last_nonfinite = 0;
-  while (t < t1) {
-    if (s.n_accepted + s.n_rejected >= max_steps) return HM_ESTEP;
-    if (h < 1e-14 * fmax(1.0, fabs(t))) return last_nonfinite ? HM_ENONFINITE : HM_ESTEP;
-    int final_step = 0;
-    if (t + h >= t1 || t + 1.01 * h >= t1) {
-      h = t1 - t;
-      final_step = 1;
+  if (t1 > t0) {
+    const double h_max = opt->h_max > 0.0 ? fmin(opt->h_max, t1 - t0) : t1 - t0;
+    if ((st = sys->rhs(t, d->x, d->k1, sys->params)) != HM_OK) return st;
+    s.n_rhs = 1;
+    double h = opt->h_init > 0.0 ? fmin(opt->h_init, h_max) : 0.0;
+    if (h == 0.0) {
+      if ((st = dopri_initial_step(d, sys, opt, t, h_max, &h)) != HM_OK) return st;
+      s.n_rhs++;
     }
-    st = dopri_try(d, sys, t, h);
-    s.n_rhs += 6;
-    double err;
-    if (st == HM_ENONFINITE)
-      err = INFINITY; /* treat as a failed step: retry smaller */
-    else if (st != HM_OK)
-      return st;
-    else
-      err = dopri_error_norm(d, opt->rtol, opt->atol, opt->err_dim);
-    last_nonfinite = !isfinite(err);
-    if (err <= 1.0) {
-      dopri_store_dense(d, t, h);
-      const double t_new = final_step ? t1 : t + h;
-      memcpy(d->x, d->xnew, n * sizeof(double));
-      memcpy(d->k1, d->k7, n * sizeof(double)); /* first same as last */
-      s.n_accepted++;
-      const double t_old = t;
-      t = t_new;
-      if (observer && observer(d, t_old, t, d->x, ctx)) break;
-      double fac = err > 0.0 ? 0.9 * pow(err, -0.2) : 5.0;
-      fac = fmin(5.0, fmax(0.2, fac));
-      if (last_rejected) fac = fmin(fac, 1.0);
-      h = fmin(h * fac, h_max);
-      last_rejected = 0;
-    } else {
-      s.n_rejected++;
-      const double fac = isfinite(err) ? fmax(0.2, 0.9 * pow(err, -0.2)) : 0.2;
-      h *= fac;
-      last_rejected = 1;
-    }
+    dopri_run r = {d, sys, opt, observer, ctx};
+    const hm_rk_method m = {dopri_attempt, dopri_accept, &r, 0.2, 0.2, 5.0, 6, 0};
+    if ((st = hm_rk_drive(&m, opt, t0, t1, h, &t, &s)) != HM_OK) return st;
   }
-  memcpy(x, d->x, n * sizeof(double));
+  memcpy(x, d->x, d->dim * sizeof(double));
   if (t_end) *t_end = t;
   if (stats) *stats = s;
   return HM_OK;

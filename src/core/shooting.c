@@ -30,12 +30,12 @@ hm_status hm_sh_init(hm_sh *c, const hm_vehicle *veh, double speed_kmh, hm_param
   const double sc[NW] = {1e-3, 1e-3, 1e-1, 1e-2, hm_sh_param_scale(param), hm_sh_param_scale(param2)};
   memcpy(c->sc, sc, sizeof sc);
   /* without p2 its sensitivity columns are left out of the integration (and of the error control) */
-  c->integ = hm_dopri_create(has_param2 ? NZ : NZ - NX);
+  c->integ = hm_dop853_create(has_param2 ? NZ : NZ - NX);
   return c->integ ? HM_OK : HM_ENOMEM;
 }
 
 void hm_sh_free(hm_sh *c) {
-  hm_dopri_destroy(c->integ);
+  hm_dop853_destroy(c->integ);
   c->integ = NULL;
 }
 
@@ -81,18 +81,36 @@ static hm_status aug_rhs(double t, const double *z, double *dz, void *ctx) {
   return HM_OK;
 }
 
-/* Track max |y| and |psi| inside every accepted step (dense output at 4 interior points). */
-static int amp_observer(hm_dopri integ, double t_old, double t_new, const double *x_new, void *ctx) {
-  hm_sh *c = (hm_sh *)ctx;
-  for (int k = 1; k < 4; ++k) {
-    double yp[3];
-    if (hm_dopri_dense_partial(integ, t_old + (t_new - t_old) * k / 4.0, 0, 3, yp) == HM_OK) {
-      c->amp_y = fmax(c->amp_y, fabs(yp[0]));
-      c->amp_psi = fmax(c->amp_psi, fabs(yp[2]));
-    }
+/* The largest |q| over a step of a coordinate q whose velocity and acceleration are known at both ends (q = y with
+ * y' = x2 and y'' = f2; q = psi likewise): at the ends, and where q' changes sign inside, at the root of q''s cubic
+ * Hermite interpolant (bisection), with q from its quintic Hermite interpolant (error O(h^6)). */
+static double extreme(double h, double q0, double v0, double a0, double q1, double v1, double a1) {
+  double m = fmax(fabs(q0), fabs(q1));
+  if ((v0 > 0.0) == (v1 > 0.0) || v0 == 0.0 || v1 == 0.0) return m;
+  double lo = 0.0, hi = 1.0; /* s in [0, 1], t = t0 + s h */
+  for (int it = 0; it < 40; ++it) {
+    const double s = 0.5 * (lo + hi), s2 = s * s, s3 = s2 * s;
+    const double v = (2 * s3 - 3 * s2 + 1) * v0 + (s3 - 2 * s2 + s) * h * a0 + (-2 * s3 + 3 * s2) * v1 +
+                     (s3 - s2) * h * a1;
+    if ((v > 0.0) == (v0 > 0.0)) lo = s;
+    else hi = s;
   }
-  c->amp_y = fmax(c->amp_y, fabs(x_new[0]));
-  c->amp_psi = fmax(c->amp_psi, fabs(x_new[2]));
+  const double s = 0.5 * (lo + hi), s2 = s * s, s3 = s2 * s, s4 = s3 * s, s5 = s4 * s;
+  /* quintic Hermite basis on [0, 1] (values, first and second derivatives at both ends) */
+  const double h00 = 1 - 10 * s3 + 15 * s4 - 6 * s5, h01 = 10 * s3 - 15 * s4 + 6 * s5;
+  const double h10 = s - 6 * s3 + 8 * s4 - 3 * s5, h11 = -4 * s3 + 7 * s4 - 3 * s5;
+  const double h20 = 0.5 * s2 - 1.5 * s3 + 1.5 * s4 - 0.5 * s5, h21 = 0.5 * s3 - s4 + 0.5 * s5;
+  const double q = h00 * q0 + h01 * q1 + h * (h10 * v0 + h11 * v1) + h * h * (h20 * a0 + h21 * a1);
+  return fmax(m, fabs(q));
+}
+
+/* Track max |y| and |psi| over every accepted step. */
+static int amp_observer(double t_old, const double *x_old, const double *f_old, double t_new, const double *x_new,
+                        const double *f_new, void *ctx) {
+  hm_sh *c = (hm_sh *)ctx;
+  const double h = t_new - t_old;
+  c->amp_y = fmax(c->amp_y, extreme(h, x_old[0], x_old[1], f_old[1], x_new[0], x_new[1], f_new[1]));
+  c->amp_psi = fmax(c->amp_psi, extreme(h, x_old[2], x_old[3], f_old[3], x_new[2], x_new[3], f_new[3]));
   return 0;
 }
 
@@ -124,7 +142,7 @@ hm_status hm_sh_shoot(hm_sh *c, const double *u, hm_shot *s) {
   const hm_dopri_options dopt = {c->opt.rtol, c->opt.atol, 0.0, 0.0, 0, NX};
   ++c->n_shots;
   hm_dopri_stats ds;
-  st = hm_dopri_integrate(c->integ, &sys, &dopt, 0.0, tau, z, NULL, amp_observer, c, &ds);
+  st = hm_dop853_integrate(c->integ, &sys, &dopt, 0.0, tau, z, amp_observer, c, &ds);
   c->n_steps += ds.n_accepted + ds.n_rejected;
   if (st != HM_OK) return st;
   double f[NX];

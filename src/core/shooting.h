@@ -22,7 +22,7 @@ typedef struct {
   int has_param2;
   int symmetric;         /* half-period shooting with x(T/2) = -x(0) */
   hm_shooting_options opt;
-  hm_dopri integ;
+  hm_dop853 integ;
   hm_model model;
   double sc[NW];         /* scale of each unknown */
   double amp_y, amp_psi; /* running maxima during an integration */

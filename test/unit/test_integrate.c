@@ -142,6 +142,89 @@ static void dopri_dense_output_and_observer(void) {
   hm_dopri_destroy(d);
 }
 
+/* ---- DOP853 ---- */
+
+static double dop853_fixed_step_error(const hm_ode_system *sys, double T, double h, const double *x0,
+                                      double (*exact)(double, int)) {
+  hm_dop853 d = hm_dop853_create(sys->dim);
+  double x[2];
+  memcpy(x, x0, sys->dim * sizeof(double));
+  const hm_dopri_options opt = {1e10, 1e10, h, h, 0, 0};
+  hm_dopri_stats st;
+  HM_CHECK(hm_dop853_integrate(d, sys, &opt, 0.0, T, x, NULL, NULL, &st) == HM_OK, "integrate");
+  HM_CHECK(st.n_rejected == 0 && st.n_rhs == 12 * st.n_accepted + 1, "fixed-step run: %zu rejected, %zu rhs",
+           st.n_rejected, st.n_rhs);
+  hm_dop853_destroy(d);
+  double err = 0.0;
+  for (size_t i = 0; i < sys->dim; ++i) err = fmax(err, fabs(x[i] - exact(T, (int)i)));
+  return err;
+}
+
+/* Order 8 from errors at h and h/2 on the oscillator and on x' = x cos t (x = exp(sin t)); a wrong coefficient in
+ * the tableau drops the order. */
+static void dop853_convergence_order_is_eight(void) {
+  const hm_ode_system osc = {2, osc_rhs, osc_jac, NULL}, es = {1, expsin_rhs, expsin_jac, NULL};
+  const double x_osc[2] = {1.0, 0.0}, x_es[1] = {1.0};
+  const double hs[] = {0.5, 0.25, 0.125};
+  double e_osc[3], e_es[3];
+  for (int i = 0; i < 3; ++i) {
+    e_osc[i] = dop853_fixed_step_error(&osc, 10.0, hs[i], x_osc, osc_exact);
+    e_es[i] = dop853_fixed_step_error(&es, 10.0, hs[i], x_es, expsin_exact);
+  }
+  for (int i = 0; i < 2; ++i) {
+    const double p_osc = log2(e_osc[i] / e_osc[i + 1]), p_es = log2(e_es[i] / e_es[i + 1]);
+    printf("  dop853 order: oscillator %.3f, exp(sin t) %.3f (errors %.1e, %.1e)\n", p_osc, p_es, e_osc[i + 1],
+           e_es[i + 1]);
+    HM_CHECK(p_osc > 7.5 && p_osc < 8.6, "oscillator order %g", p_osc);
+    HM_CHECK(p_es > 7.5 && p_es < 8.8, "exp(sin t) order %g", p_es);
+  }
+}
+
+typedef struct {
+  int calls;
+  double worst; /* largest |x - exact| at the step ends */
+} step_ctx;
+
+static int step_check(double t_old, const double *x_old, const double *f_old, double t_new, const double *x_new,
+                      const double *f_new, void *ctx) {
+  step_ctx *c = (step_ctx *)ctx;
+  (void)f_old;
+  (void)f_new;
+  c->worst = fmax(c->worst, fmax(fabs(x_old[0] - cos(t_old)), fabs(x_new[0] - cos(t_new))));
+  return ++c->calls == 1000000;
+}
+
+/* Adaptive: 100 periods of the oscillator with a global error below 2e-8 at a step tolerance of 1e-10, in far fewer steps than Dormand-Prince 5(4)
+ * at the same tolerance; the observer sees the exact solution at every step end; an observer can stop the run. */
+static void dop853_adaptive_and_observer(void) {
+  const hm_ode_system osc = {2, osc_rhs, NULL, NULL};
+  hm_dop853 d = hm_dop853_create(2);
+  hm_dopri p = hm_dopri_create(2);
+  const double T = 200.0 * HM_PI;
+  const hm_dopri_options opt = {1e-10, 1e-10, 0.0, 0.0, 0, 0};
+  double x[2] = {1.0, 0.0}, y[2] = {1.0, 0.0};
+  hm_dopri_stats s8, s5;
+  step_ctx c = {0, 0.0};
+  HM_CHECK(hm_dop853_integrate(d, &osc, &opt, 0.0, T, x, step_check, &c, &s8) == HM_OK, "dop853");
+  HM_CHECK(hm_dopri_integrate(p, &osc, &opt, 0.0, T, y, NULL, NULL, NULL, &s5) == HM_OK, "dopri");
+  printf("  100 periods at 1e-10: dop853 %zu steps (%zu rhs), error %.1e; dopri5 %zu steps (%zu rhs)\n",
+         s8.n_accepted, s8.n_rhs, fabs(x[0] - 1.0), s5.n_accepted, s5.n_rhs);
+  HM_CHECK_DELTA(x[0], 1.0, 2e-8, "x(100 periods)");
+  HM_CHECK(c.worst < 2e-8 && c.calls == (int)s8.n_accepted, "observer: %d calls, worst %g", c.calls, c.worst);
+  HM_CHECK(s8.n_rhs < s5.n_rhs, "no fewer right-hand sides than dopri5");
+  step_ctx stop = {999997, 0.0};
+  double z[2] = {1.0, 0.0};
+  HM_CHECK(hm_dop853_integrate(d, &osc, &opt, 0.0, T, z, step_check, &stop, &s8) == HM_OK && s8.n_accepted == 3,
+           "observer stop after %zu steps", s8.n_accepted);
+  const hm_dopri_options neg = {-1.0, 1e-9, 0.0, 0.0, 0, 0};
+  double w[2] = {NAN, 0.0};
+  HM_CHECK(hm_dop853_integrate(d, &osc, &neg, 0.0, 1.0, x, NULL, NULL, NULL) == HM_EINVAL, "rtol < 0");
+  HM_CHECK(hm_dop853_integrate(d, &osc, &opt, 0.0, 1.0, w, NULL, NULL, NULL) == HM_ENONFINITE, "NaN start");
+  HM_CHECK(hm_dop853_create(0) == NULL, "dim 0");
+  hm_dop853_destroy(d);
+  hm_dopri_destroy(p);
+}
+
 /* The oscillator plus a rapidly decaying, uncontrolled passenger z' = -30 z (components 2, 3 = two copies): with
  * err_dim 2 the steps are those of the oscillator integrated alone (the reference run), with all components under
  * control the stiff-ish passenger takes more; the oscillator's solution stays within its tolerance. */
@@ -257,6 +340,8 @@ int main(void) {
   HM_RUN(dopri_error_control_tracks_tolerance);
   HM_RUN(dopri_dense_output_and_observer);
   HM_RUN(dopri_error_control_on_leading_components);
+  HM_RUN(dop853_convergence_order_is_eight);
+  HM_RUN(dop853_adaptive_and_observer);
   HM_RUN(variational_matrix_is_the_rotation);
   HM_RUN(midpoint_order_two_and_invariant);
   HM_RUN(integrator_bad_inputs);
