@@ -115,6 +115,8 @@ hm_status hm_alarm_create(const hm_alarm_config *cfg, const hm_vehicle *veh, con
 void hm_alarm_destroy(hm_alarm alarm);
 /* Back to NO_DATA / starting (the stream was restarted). */
 void hm_alarm_reset(hm_alarm alarm);
+/* Look boundaries up in this table from the next update on (borrowed, as at create; the level is kept). */
+void hm_alarm_set_table(hm_alarm alarm, const hm_table table);
 
 /* Evaluate at time now_s with the estimator's output and the margin's (margin may be NULL: no estimate).
  * HM_EINVAL for NULL arguments or a non-finite now; the table lookup's status if it fails. The alarm's state and

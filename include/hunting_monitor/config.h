@@ -52,10 +52,10 @@ hm_status hm_config_parse_vehicle(const char *text, size_t len, const char *sour
 hm_status hm_config_load_vehicle(const char *path, hm_vehicle *veh, char *name, char *err, size_t err_len);
 
 /*
- * Monitor settings (config/monitor.yaml): optional sections `estimator:`, `modal:`, `margin:` and `alarm:` whose
- * keys are the field names of hm_estimator_config, hm_modal_config, hm_margin_config and hm_alarm_config
- * (use_conicity_estimate: true/false; measurement_point: wheelset/bogie_frame, which first sets the criteria's
- * defaults for that point, hm_estimator_config_criteria, then the section's other keys apply). Fields not given keep
+ * Monitor settings (config/monitor.yaml): optional sections `estimator:`, `modal:`, `margin:`, `alarm:` and `table:`
+ * whose keys are the field names of hm_estimator_config, hm_modal_config, hm_margin_config, hm_alarm_config and
+ * hm_monitor_config.table (refine and use_conicity_estimate: true/false; measurement_point: wheelset/bogie_frame,
+ * which first sets the criteria's defaults for that point, hm_estimator_config_criteria, then the section's other keys apply). Fields not given keep
  * the values *cfg holds on entry (pass the defaults); unknown keys and non-numbers are errors (HM_EPARSE), then the
  * whole configuration is validated (HM_EDOMAIN). Output untouched on failure. Other top-level sections (vehicle,
  * conicity, flange) are ignored, so one file may hold both.

@@ -7,6 +7,10 @@
  *    Hopf speed against the closed form); without one it is computed for the vehicle (table_n_conicity conicities);
  *  - the conicity fallback: the alarm's conicity_fallback, or the vehicle's own lambda(0) when that is 0 (so a
  *    fitted or worn vehicle never falls back to the default vehicle's conicity);
+ *  - the table's refinement: where the table's expected interpolation error at the conicity in use
+ *    (hm_table_local_error) exceeds the tolerances, the exact family there is wanted (hm_monitor_table_wanted); the
+ *    caller computes it with hm_table_refine, on another thread if it likes (the table is only read), and hands
+ *    the result back (hm_monitor_replace_table). The monitor itself never blocks on a computation after create;
  *  - the identification follows the estimator: restarted after a gap, redesigned for a measured sample rate.
  * At a steady speed the identification's windows go to the margin with the speed's mean and range: the current
  * stretch provisionally (from min_window_s), committed in full windows (window_s) and when the stretch ends.
@@ -35,9 +39,15 @@ typedef struct {
   hm_margin_config margin;
   hm_alarm_config alarm;
   size_t table_n_conicity; /* conicities of a table computed at start (when none is given) */
+  struct {
+    int refine;              /* 1: want the exact family where the interpolation would err more than below */
+    double tolerance_kmh;    /* on the lowest cycle speed */
+    double tolerance_m;      /* on the cycle amplitudes */
+    unsigned max_curves;     /* stop refining at this many curves (memory: 5-50 kB each) */
+  } table;
 } hm_monitor_config;
 
-/* Every part's defaults; 8 conicities for a computed table. */
+/* Every part's defaults; 15 conicities for a computed table; refinement on, 0.05 km/h, 5 um, 200 curves. */
 void hm_monitor_config_default(hm_monitor_config *cfg);
 /* The first invalid field as "section.field: reason". */
 hm_status hm_monitor_config_validate(const hm_monitor_config *cfg, char *why, size_t why_len);
@@ -61,6 +71,9 @@ typedef struct hm_monitor_s *hm_monitor;
  */
 hm_status hm_monitor_create(const hm_monitor_config *cfg, const hm_vehicle *veh, hm_table table, hm_monitor *out,
                             char *why, size_t why_len);
+/* The same, a table to compute being computed through pfor(runner, ...) (tables.h; e.g. on every processor). */
+hm_status hm_monitor_create_parallel(const hm_monitor_config *cfg, const hm_vehicle *veh, hm_table table,
+                                     hm_parallel_for_fn pfor, void *runner, hm_monitor *out, char *why, size_t why_len);
 void hm_monitor_destroy(hm_monitor m);
 /* Forget the stream (time jumped): estimator, identification, margin (its windows' times are on the old time line)
  * and alarm state. */
@@ -73,8 +86,18 @@ hm_status hm_monitor_push_speed(hm_monitor m, double t_s, double speed_kmh);
 /* Evaluate at now_s. HM_EINVAL for NULL or non-finite now; out untouched on failure. */
 hm_status hm_monitor_update(hm_monitor m, double now_s, hm_monitor_status *out);
 
-/* The table in use (borrowed), e.g. for reporting its range and errors. */
+/* The table in use (borrowed, valid until the next hm_monitor_replace_table), e.g. for reporting its range and
+ * errors, or to refine (hm_table_refine only reads it). */
 hm_table hm_monitor_table(const hm_monitor m);
+
+/* 1 with the conicity in use (of the latest update, not NO_DATA) in *conicity when refinement is on, the table has
+ * fewer than max_curves curves and its expected interpolation error there exceeds a tolerance; else 0. */
+int hm_monitor_table_wanted(const hm_monitor m, double *conicity);
+/* Use table from the next update on. The monitor takes it over (also on failure, when it is destroyed). The table
+ * it replaces goes to *replaced (the caller destroys it, e.g. on the thread that made the new one, off the
+ * callbacks) or, with replaced NULL, is destroyed. HM_EDOMAIN (reason in why) for a table of another vehicle,
+ * which is not used (*replaced is then NULL). */
+hm_status hm_monitor_replace_table(hm_monitor m, hm_table table, hm_table *replaced, char *why, size_t why_len);
 
 #ifdef __cplusplus
 }

@@ -104,6 +104,16 @@ void hm_table_vehicle(const hm_table t, double *kx_mn_m, double *ky_mn_m);
 #define HM_TABLE_CHECK_TOL_KMH 0.01 /* tables are written with 10 significant digits: 1e-7 km/h of rounding */
 hm_status hm_table_check_vehicle(const hm_table t, const hm_vehicle *veh, double tol_kmh, char *why, size_t why_len);
 
+/* The interpolation error to expect at a conicity: the table's measured errors (at the midpoints of its original
+ * grid step h0, where linear interpolation errs most) scaled by 4 d (h - d) / h0^2, d the distance to the curve
+ * below in an interval of width h (the parabolic error profile of linear interpolation; 0 on a curve). */
+hm_status hm_table_local_error(const hm_table t, double conicity, double *err_speed_kmh, double *err_amp_m);
+
+/* A copy of t with the exact cycle family at this conicity added (one continuation, 10-60 ms), for veh (checked
+ * against the table as hm_table_check_vehicle does). t is only read: another thread may keep using it meanwhile.
+ * HM_EDOMAIN for a conicity outside the table or on one of its curves. */
+hm_status hm_table_refine(const hm_table t, const hm_vehicle *veh, double conicity, hm_table *out);
+
 /* Number of conicities and the range, for reporting. */
 size_t hm_table_size(const hm_table t, double *conicity_min, double *conicity_max);
 

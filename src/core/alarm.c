@@ -109,6 +109,12 @@ void hm_alarm_reset(hm_alarm a) {
   a->have_lookup = 0;
 }
 
+void hm_alarm_set_table(hm_alarm a, const hm_table table) {
+  if (!a || !table) return;
+  a->table = table;
+  a->have_lookup = 0; /* the cached lookups were the old table's */
+}
+
 /* The level the conditions call for, with the thresholds of levels at or below `current` relaxed. */
 static hm_level raw_level(const hm_alarm a, const hm_estimate *e, const hm_margin_estimate *g, const hm_assessment *s,
                           hm_level current, hm_reason *reason) {

@@ -310,6 +310,7 @@ typedef struct {
 #define MOD(f, t) {#f, t, offsetof(hm_monitor_config, modal) + offsetof(hm_modal_config, f)}
 #define MAR(f, t) {#f, t, offsetof(hm_monitor_config, margin) + offsetof(hm_margin_config, f)}
 #define ALM(f, t) {#f, t, offsetof(hm_monitor_config, alarm) + offsetof(hm_alarm_config, f)}
+#define TAB(f, t) {#f, t, offsetof(hm_monitor_config, table.f)}
 
 static const settings_field estimator_fields[] = {
     EST(measurement_point, FIELD_POINT),
@@ -346,6 +347,11 @@ static const settings_field alarm_fields[] = {
     ALM(conicity_max_se, FIELD_DOUBLE),         ALM(conicity_fallback, FIELD_DOUBLE),
 };
 
+static const settings_field table_fields[] = {
+    TAB(refine, FIELD_BOOL), TAB(tolerance_kmh, FIELD_DOUBLE), TAB(tolerance_m, FIELD_DOUBLE),
+    TAB(max_curves, FIELD_UNSIGNED),
+};
+
 static const struct {
   const char *name;
   const settings_field *fields;
@@ -353,7 +359,8 @@ static const struct {
 } sections[] = {{"estimator", estimator_fields, sizeof estimator_fields / sizeof estimator_fields[0]},
                 {"modal", modal_fields, sizeof modal_fields / sizeof modal_fields[0]},
                 {"margin", margin_fields, sizeof margin_fields / sizeof margin_fields[0]},
-                {"alarm", alarm_fields, sizeof alarm_fields / sizeof alarm_fields[0]}};
+                {"alarm", alarm_fields, sizeof alarm_fields / sizeof alarm_fields[0]},
+                {"table", table_fields, sizeof table_fields / sizeof table_fields[0]}};
 
 /* One key's value into the field at base + f->offset. */
 static hm_status apply_field(parse_ctx *c, const settings_field *f, yaml_node_t *v, const char *path, void *base) {

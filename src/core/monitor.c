@@ -32,6 +32,7 @@ struct hm_monitor_s {
   double mode_speed, mode_spread;
   hm_window_verdict verdict;
   double committed_until;        /* end of the last window committed to the margin (or the stream's restart) */
+  double conicity_in_use;        /* of the latest update that had data; NAN before */
 };
 
 void hm_monitor_config_default(hm_monitor_config *c) {
@@ -39,7 +40,11 @@ void hm_monitor_config_default(hm_monitor_config *c) {
   hm_modal_config_default(&c->modal);
   hm_margin_config_default(&c->margin);
   hm_alarm_config_default(&c->alarm);
-  c->table_n_conicity = 8;
+  c->table_n_conicity = 15;
+  c->table.refine = 1;
+  c->table.tolerance_kmh = 0.05;
+  c->table.tolerance_m = 5e-6;
+  c->table.max_curves = 200;
 }
 
 static hm_status prefixed(hm_status st, const char *section, char *why, size_t len) {
@@ -61,6 +66,15 @@ hm_status hm_monitor_config_validate(const hm_monitor_config *c, char *why, size
     if (why && len) snprintf(why, len, "table_n_conicity: must be 2..1000 (got %zu)", c->table_n_conicity);
     st = HM_EDOMAIN;
   }
+  if (st == HM_OK && (!(c->table.tolerance_kmh > 0.0) || !(c->table.tolerance_m > 0.0) ||
+                      !isfinite(c->table.tolerance_kmh) || !isfinite(c->table.tolerance_m) ||
+                      (c->table.refine != 0 && c->table.refine != 1) || c->table.max_curves > 10000)) {
+    if (why && len)
+      snprintf(why, len, "table: tolerance_kmh and tolerance_m must be finite and > 0, refine 0 or 1, max_curves at "
+                         "most 10000 (got %g, %g, %d, %u)", c->table.tolerance_kmh, c->table.tolerance_m,
+               c->table.refine, c->table.max_curves);
+    st = HM_EDOMAIN;
+  }
   return st;
 }
 
@@ -80,6 +94,11 @@ static void restart_stream(hm_monitor m) {
 
 hm_status hm_monitor_create(const hm_monitor_config *cfg, const hm_vehicle *veh, hm_table table, hm_monitor *out,
                             char *why, size_t len) {
+  return hm_monitor_create_parallel(cfg, veh, table, NULL, NULL, out, why, len);
+}
+
+hm_status hm_monitor_create_parallel(const hm_monitor_config *cfg, const hm_vehicle *veh, hm_table table,
+                                     hm_parallel_for_fn pfor, void *runner, hm_monitor *out, char *why, size_t len) {
   hm_status st = !cfg || !veh || !out ? HM_EINVAL : hm_monitor_config_validate(cfg, why, len);
   if (st == HM_OK) st = hm_vehicle_validate(veh, why, len);
   if (st == HM_OK && table) st = hm_table_check_vehicle(table, veh, HM_TABLE_CHECK_TOL_KMH, why, len);
@@ -87,7 +106,7 @@ hm_status hm_monitor_create(const hm_monitor_config *cfg, const hm_vehicle *veh,
     hm_table_spec spec;
     hm_table_spec_default(&spec);
     spec.n_conicity = cfg->table_n_conicity;
-    st = hm_table_build(veh, &spec, &table);
+    st = hm_table_build_parallel(veh, &spec, pfor, runner, &table);
     if (st != HM_OK && why && len) snprintf(why, len, "computing the boundary tables: %s", hm_status_str(st));
   }
   hm_monitor m = st == HM_OK ? calloc(1, sizeof *m) : NULL;
@@ -111,6 +130,7 @@ hm_status hm_monitor_create(const hm_monitor_config *cfg, const hm_vehicle *veh,
     return st;
   }
   m->modal_ok = 1;
+  m->conicity_in_use = NAN;
   m->restarts = hm_estimator_restarts(m->est, &m->rate_hz);
   restart_stream(m);
   *out = m;
@@ -235,6 +255,8 @@ hm_status hm_monitor_update(hm_monitor m, double now, hm_monitor_status *out) {
   hm_margin_read(m->margin, now, &s.margin);
   const hm_status st = hm_alarm_update(m->alarm, &s.estimate, &s.margin, now, &s.assessment);
   if (st != HM_OK) return st;
+  if (s.assessment.level != HM_LEVEL_NO_DATA && isfinite(s.assessment.conicity))
+    m->conicity_in_use = s.assessment.conicity;
   s.mode = m->mode;
   s.mode_speed_kmh = m->mode_speed;
   s.mode_speed_spread_kmh = isfinite(m->mode_spread) ? m->mode_spread : -1.0;
@@ -244,3 +266,32 @@ hm_status hm_monitor_update(hm_monitor m, double now, hm_monitor_status *out) {
 }
 
 hm_table hm_monitor_table(const hm_monitor m) { return m ? m->table : NULL; }
+
+int hm_monitor_table_wanted(const hm_monitor m, double *conicity) {
+  if (!m || !conicity || !m->cfg.table.refine || !isfinite(m->conicity_in_use)) return 0;
+  double lo, hi, e_kmh, e_m;
+  if (hm_table_size(m->table, &lo, &hi) >= m->cfg.table.max_curves) return 0;
+  if (!(m->conicity_in_use > lo && m->conicity_in_use < hi)) return 0; /* outside: clamped, nothing to add */
+  if (hm_table_local_error(m->table, m->conicity_in_use, &e_kmh, &e_m) != HM_OK) return 0;
+  if (e_kmh <= m->cfg.table.tolerance_kmh && e_m <= m->cfg.table.tolerance_m) return 0;
+  *conicity = m->conicity_in_use;
+  return 1;
+}
+
+hm_status hm_monitor_replace_table(hm_monitor m, hm_table table, hm_table *replaced, char *why, size_t len) {
+  if (replaced) *replaced = NULL;
+  if (!m || !table) {
+    hm_table_destroy(table);
+    return HM_EINVAL;
+  }
+  const hm_status st = hm_table_check_vehicle(table, &m->veh, HM_TABLE_CHECK_TOL_KMH, why, len);
+  if (st != HM_OK) {
+    hm_table_destroy(table);
+    return st;
+  }
+  hm_alarm_set_table(m->alarm, table);
+  if (replaced) *replaced = m->table;
+  else hm_table_destroy(m->table);
+  m->table = table;
+  return HM_OK;
+}

@@ -82,6 +82,17 @@ static curve_cycles cycles_of(const tcurve *c, double v) {
   return r;
 }
 
+/* The interval [curves[i], curves[i+1]] holding c (clamped). */
+static size_t interval_of(const hm_table t, double c) {
+  size_t lo = 0, hi = t->n - 1;
+  while (hi - lo > 1) {
+    const size_t mid = (lo + hi) / 2;
+    if (t->curves[mid].conicity <= c) lo = mid;
+    else hi = mid;
+  }
+  return lo;
+}
+
 hm_status hm_table_lookup(const hm_table t, double conicity, double speed_kmh, hm_table_lookup_result *out) {
   if (!t || !out || t->n < 2) return HM_EINVAL;
   if (!isfinite(conicity) || !isfinite(speed_kmh)) return HM_EDOMAIN;
@@ -97,16 +108,7 @@ hm_status hm_table_lookup(const hm_table t, double conicity, double speed_kmh, h
     v = fmin(fmax(v, t->speed_min_kmh), t->speed_max_kmh);
     r.clamped = 1;
   }
-  size_t i = 0; /* bracketing curves i, i+1 (binary search on the sorted conicities) */
-  size_t lo = 0, hi = t->n - 1;
-  while (hi - lo > 1) {
-    const size_t mid = (lo + hi) / 2;
-    if (t->curves[mid].conicity <= c)
-      lo = mid;
-    else
-      hi = mid;
-  }
-  i = lo;
+  const size_t i = interval_of(t, c); /* bracketing curves i, i+1 */
   const tcurve *a = &t->curves[i], *b = &t->curves[i + 1];
   const double w = (c - a->conicity) / (b->conicity - a->conicity);
   r.conicity = c;
@@ -204,7 +206,9 @@ static hm_status curve_at(const hm_vehicle *veh, const hm_table_spec *spec, doub
   o.amp_max_m = spec->amp_max_m;
   o.shoot.rtol = spec->rtol;
   o.shoot.atol = spec->rtol * 1e-3;
-  enum { CAP = 20000 };
+  /* every point the continuation can make: the two at the start and one per step attempt (300 kB, not the 3 MB of a
+   * fixed 20000: a worker refining the table in the background then stays in the heap, off mmap/munmap) */
+  const size_t CAP = o.cont.max_steps + 2;
   hm_cycle_point *pts = malloc(CAP * sizeof *pts);
   enum { MAX_EV = 64 };
   tpoint *tp = malloc((CAP + MAX_EV + 1) * sizeof *tp);
@@ -348,7 +352,69 @@ hm_status hm_table_build_parallel(const hm_vehicle *veh, const hm_table_spec *sp
   t->err_hopf_kmh = e_hopf;
   t->err_lowest_kmh = e_low;
   t->err_amp_m = e_amp;
+  t->err_step = (spec->conicity_max - spec->conicity_min) / (double)(n - 1);
+  t->rtol = spec->rtol;
   *out = t;
+  return HM_OK;
+}
+
+hm_status hm_table_local_error(const hm_table t, double conicity, double *err_speed_kmh, double *err_amp_m) {
+  if (!t || t->n < 2 || !err_speed_kmh || !err_amp_m) return HM_EINVAL;
+  if (!isfinite(conicity)) return HM_EDOMAIN;
+  const double c = fmin(fmax(conicity, t->curves[0].conicity), t->curves[t->n - 1].conicity);
+  const size_t i = interval_of(t, c);
+  const double d = c - t->curves[i].conicity, step = t->curves[i + 1].conicity - t->curves[i].conicity;
+  const double f = t->err_step > 0.0 ? fmax(0.0, 4.0 * d * (step - d)) / (t->err_step * t->err_step) : 1.0;
+  *err_speed_kmh = f * fmax(t->err_hopf_kmh, t->err_lowest_kmh);
+  *err_amp_m = f * t->err_amp_m;
+  return HM_OK;
+}
+
+hm_status hm_table_refine(const hm_table t, const hm_vehicle *veh, double conicity, hm_table *out) {
+  if (!t || !veh || !out || t->n < 2) return HM_EINVAL;
+  if (!isfinite(conicity)) return HM_EDOMAIN;
+  if (!(conicity > t->curves[0].conicity && conicity < t->curves[t->n - 1].conicity)) return HM_EDOMAIN;
+  const size_t i = interval_of(t, conicity);
+  if (conicity == t->curves[i].conicity) return HM_EDOMAIN; /* already exact there */
+  hm_status st = hm_table_check_vehicle(t, veh, HM_TABLE_CHECK_TOL_KMH, NULL, 0);
+  if (st != HM_OK) return st;
+  hm_table_spec spec;
+  hm_table_spec_default(&spec);
+  spec.speed_min_kmh = t->speed_min_kmh;
+  spec.speed_max_kmh = t->speed_max_kmh;
+  spec.amp_max_m = t->amp_max_m;
+  spec.rtol = t->rtol;
+  tcurve fresh;
+  if ((st = curve_at(veh, &spec, conicity, &fresh)) != HM_OK) return st;
+  hm_table r = hm_table_alloc(t->n + 1);
+  if (!r) {
+    free(fresh.pts);
+    return HM_ENOMEM;
+  }
+  tcurve *curves = r->curves;
+  *r = *t;
+  r->n = t->n + 1;
+  r->curves = curves;
+  for (size_t k = 0, j = 0; k < r->n; ++k) {
+    if (k == i + 1) {
+      r->curves[k] = fresh;
+      continue;
+    }
+    const tcurve *src = &t->curves[j++];
+    r->curves[k] = *src;
+    r->curves[k].pts = malloc(src->n * sizeof *src->pts);
+    if (!r->curves[k].pts) {
+      st = HM_ENOMEM;
+      r->curves[k].n = 0;
+      continue;
+    }
+    memcpy(r->curves[k].pts, src->pts, src->n * sizeof *src->pts);
+  }
+  if (st != HM_OK) {
+    hm_table_destroy(r);
+    return st;
+  }
+  *out = r;
   return HM_OK;
 }
 

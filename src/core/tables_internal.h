@@ -19,6 +19,8 @@ typedef struct {
 struct hm_table_s {
   double kx_mn_m, ky_mn_m, speed_min_kmh, speed_max_kmh, amp_max_m;
   double err_hopf_kmh, err_lowest_kmh, err_amp_m;
+  double err_step;   /* the conicity step over which those errors were measured (the original uniform grid's) */
+  double rtol;       /* the shooting tolerance its families were computed with */
   size_t n;
   tcurve *curves;
 };

@@ -175,9 +175,15 @@ hm_status hm_table_parse(const char *text, size_t len, hm_table *out, char *err,
     prev = t->curves[i].conicity;
   }
   if (st == HM_OK && next_line(&r, line, sizeof line)) st = perr(&r, "unexpected text after the last record");
-  for (size_t i = 1; st == HM_OK && i < n; ++i) /* 1/V_hopf^2 is affine and increasing in lambda (tables.h) */
+  for (size_t i = 1; st == HM_OK && i < n; ++i) { /* 1/V_hopf^2 is affine and increasing in lambda (tables.h) */
     if (!(t->curves[i].hopf_kmh < t->curves[i - 1].hopf_kmh))
       st = perr(&r, "hopf_kmh must decrease as the conicity increases (conicity %g)", t->curves[i].conicity);
+    /* the stated errors were measured on the grid's widest step (a refined table's is wider than its others) */
+    t->err_step = fmax(t->err_step, t->curves[i].conicity - t->curves[i - 1].conicity);
+  }
+  hm_table_spec spec;
+  hm_table_spec_default(&spec);
+  t->rtol = spec.rtol;
   if (st != HM_OK) {
     hm_table_destroy(t);
     return st;

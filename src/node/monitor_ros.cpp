@@ -11,6 +11,7 @@
 
 extern "C" {
 #include "hunting_monitor/config.h"
+#include "hunting_monitor/threads.h"
 }
 
 namespace hunting_monitor {
@@ -38,6 +39,7 @@ MonitorRos::MonitorRos(ros::NodeHandle nh, ros::NodeHandle pnh) : nh_(nh), pnh_(
   updater_.add(*accel_freq_);
   updater_.add("inputs", this, &MonitorRos::diagnoseInputs);
   updater_.add("hunting level", this, &MonitorRos::diagnoseLevel);
+  updater_.add("boundary table", this, &MonitorRos::diagnoseTable);
   timer_ = nh_.createTimer(ros::Duration(1.0 / status_rate_hz_), &MonitorRos::onTimer, this);
   ok_ = true;
   ROS_INFO("hunting_monitor: ready (accel %s at %.0f Hz stamped by %s time, speed in %s, status at %.1f Hz, table %s)",
@@ -45,7 +47,10 @@ MonitorRos::MonitorRos(ros::NodeHandle nh, ros::NodeHandle pnh) : nh_(nh), pnh_(
            table_file_.c_str());
 }
 
-MonitorRos::~MonitorRos() { hm_monitor_destroy(monitor_); }
+MonitorRos::~MonitorRos() {
+  refiner_.reset();  // joins the worker, which may be reading the monitor's table
+  hm_monitor_destroy(monitor_);
+}
 
 bool MonitorRos::loadParameters() {
   char err[512] = "";
@@ -56,7 +61,7 @@ bool MonitorRos::loadParameters() {
     return false;
   }
   hm_monitor_config_default(&cfg_);
-  const std::string monitor_yaml = sectionsAsYaml(pnh_, {"estimator", "modal", "margin", "alarm"});
+  const std::string monitor_yaml = sectionsAsYaml(pnh_, {"estimator", "modal", "margin", "alarm", "table"});
   if (hm_config_parse_monitor(monitor_yaml.c_str(), monitor_yaml.size(), "~ (monitor parameters)", &cfg_, err,
                               sizeof err) != HM_OK) {
     ROS_FATAL("hunting_monitor: %s", err);
@@ -69,6 +74,7 @@ bool MonitorRos::loadParameters() {
   pnh_.param<std::string>("frame_id", frame_id_, "base_link");
   pnh_.param<std::string>("table_file", table_file_, "");
   pnh_.param("status_rate_hz", status_rate_hz_, 20.0);
+  pnh_.param("bench_table_churn", bench_table_churn_, false);
   pnh_.param("max_clock_offset_s", max_clock_offset_s_, 1.0);
   if (!(max_clock_offset_s_ > 0.0 && max_clock_offset_s_ <= 3600.0)) {
     ROS_FATAL("hunting_monitor: ~max_clock_offset_s must be in (0, 3600], got %g", max_clock_offset_s_);
@@ -99,9 +105,9 @@ bool MonitorRos::loadParameters() {
   }
   // The start-up policy (table checked against the vehicle or computed for it, fallback conicity) is the core's.
   hm_table table = nullptr;
-  if (table_file_.empty()) {  // computed on start (seconds); a file made with `hunting tables` starts at once
-    int n = 8;
-    pnh_.param("table_n", n, 8);
+  if (table_file_.empty()) {  // computed on start (on every processor: 15 conicities in about 0.3 s)
+    int n = static_cast<int>(cfg_.table_n_conicity);
+    pnh_.param("table_n", n, n);
     if (n < 2 || n > 1000) {
       ROS_FATAL("hunting_monitor: ~table_n must be 2..1000, got %d", n);
       return false;
@@ -113,13 +119,60 @@ bool MonitorRos::loadParameters() {
     ROS_FATAL("hunting_monitor: ~table_file: %s", err);
     return false;
   }
-  const hm_status st = hm_monitor_create(&cfg_, &vehicle_, table, &monitor_, err, sizeof err);
+  hm_threads threads = {0};
+  const hm_status st =
+      hm_monitor_create_parallel(&cfg_, &vehicle_, table, hm_threads_parallel_for, &threads, &monitor_, err, sizeof err);
   if (st != HM_OK) {
     ROS_FATAL("hunting_monitor: %s%s: %s", table ? "~table_file " : "", table ? table_file_.c_str() : "",
               *err ? err : hm_status_str(st));
     return false;
   }
+  refiner_.reset(new TableRefiner(vehicle_));
   return true;
+}
+
+void MonitorRos::refineTable() {
+  bool failed = false;
+  hm_status st = HM_OK;
+  double c = 0.0, secs = 0.0;
+  hm_table done = refiner_->take(&failed, &st, &c, &secs);
+  if (done) {
+    char err[256] = "";
+    hm_table old = nullptr;
+    st = hm_monitor_replace_table(monitor_, done, &old, err, sizeof err);  // the monitor takes it over
+    refiner_->retire(old);
+    if (st == HM_OK) {
+      ++refinements_;
+      last_refined_conicity_ = c;
+      last_refine_s_ = secs;
+      ROS_INFO_COND(!bench_table_churn_,
+                    "hunting_monitor: exact cycle family at conicity %.4f added to the table (%.0f ms, %zu conicities)",
+                    c, 1e3 * secs, hm_table_size(hm_monitor_table(monitor_), nullptr, nullptr));
+    } else {
+      failed = true;
+      last_refine_error_ = err;
+    }
+  } else if (failed) {
+    last_refine_error_ = hm_status_str(st);
+  }
+  if (failed) {  // not retried at that conicity: the table's interpolation stays in use there
+    ++refinement_failures_;
+    failed_conicity_ = c;
+    ROS_WARN_COND(!bench_table_churn_, "hunting_monitor: no exact cycle family at conicity %.4f: %s", c,
+                  last_refine_error_.c_str());
+  }
+  double want = 0.0, lo = 0.0, hi = 0.0;
+  if (refiner_->busy()) return;
+  if (hm_monitor_table_wanted(monitor_, &want) && std::fabs(want - failed_conicity_) > 1e-4) {
+    refiner_->request(hm_monitor_table(monitor_), want);
+  } else if (bench_table_churn_ && ros::WallTime::now().toSec() >= next_churn_ &&
+             hm_table_size(hm_monitor_table(monitor_), &lo, &hi) < cfg_.table.max_curves) {
+    // benchmarking only: an exact family twice a second (far more often than the conicity in use moves), at
+    // conicities spread over the table (golden-ratio steps)
+    next_churn_ = ros::WallTime::now().toSec() + 0.5;
+    churn_ = std::fmod(churn_ + 0.6180339887498949, 1.0);
+    refiner_->request(hm_monitor_table(monitor_), lo + (0.02 + 0.96 * churn_) * (hi - lo));
+  }
 }
 
 void MonitorRos::timeJumped(const std::string& what) {
@@ -192,6 +245,7 @@ void MonitorRos::onTimer(const ros::TimerEvent&) {
   checkRosTime(now);
   hm_monitor_status st;
   if (hm_monitor_update(monitor_, now.toSec(), &st) != HM_OK) return;
+  refineTable();
   last_ = st;
   have_last_ = true;
   const hm_estimate& e = st.estimate;
@@ -240,6 +294,13 @@ void MonitorRos::onTimer(const ros::TimerEvent&) {
   m.lowest_cycle_speed_kmh = s.boundaries_valid ? finite(b.lowest_cycle_speed_kmh) : 0.0;
   m.margin_to_hopf_kmh = s.boundaries_valid ? finite(s.margin_hopf_kmh) : 0.0;
   m.margin_to_lowest_cycle_kmh = s.boundaries_valid ? finite(s.margin_lowest_cycle_kmh) : 0.0;
+  m.table_conicities = static_cast<uint32_t>(hm_table_size(hm_monitor_table(monitor_), nullptr, nullptr));
+  double err_kmh = 0.0, err_m = 0.0;
+  if (s.boundaries_valid && hm_table_local_error(hm_monitor_table(monitor_), s.conicity, &err_kmh, &err_m) == HM_OK) {
+    m.table_error_speed_kmh = finite(err_kmh);
+    m.table_error_amp_m = finite(err_m);
+  }
+  m.table_refining = refiner_->busy();
   m.amplitude_accel_mps2 = finite(e.amplitude_accel_mps2);
   m.amplitude_displacement_m = finite(e.amplitude_displacement_m);
   m.frequency_hz = finite(e.frequency_hz);
@@ -369,6 +430,31 @@ void MonitorRos::diagnoseLevel(diagnostic_updater::DiagnosticStatusWrapper& stat
     if (g.hopf_free_valid) stat.add("model-free Hopf [km/h]", g.hopf_free_kmh);
     stat.add("model mismatch", static_cast<bool>(g.model_mismatch));
   }
+}
+
+void MonitorRos::diagnoseTable(diagnostic_updater::DiagnosticStatusWrapper& stat) {
+  const hm_table t = hm_monitor_table(monitor_);
+  double lo = 0.0, hi = 0.0, err_kmh = 0.0, err_m = 0.0;
+  const size_t n = hm_table_size(t, &lo, &hi);
+  const bool at_use = have_last_ && last_.assessment.boundaries_valid &&
+                      hm_table_local_error(t, last_.assessment.conicity, &err_kmh, &err_m) == HM_OK;
+  const bool within = !at_use || (err_kmh <= cfg_.table.tolerance_kmh && err_m <= cfg_.table.tolerance_m);
+  char text[160];
+  std::snprintf(text, sizeof text, "%zu conicities %.3f-%.3f, %lu exact families added%s", n, lo, hi, refinements_,
+                refiner_->busy() ? ", computing one" : "");
+  stat.summary(refinement_failures_ == 0 && (within || refiner_->busy()) ? diagnostic_msgs::DiagnosticStatus::OK
+                                                                          : diagnostic_msgs::DiagnosticStatus::WARN,
+               std::string(text) + (within ? "" : "; interpolated beyond the tolerance at the conicity in use"));
+  stat.add("file", table_file_);
+  if (at_use) {
+    stat.add("expected error at the conicity in use [km/h]", err_kmh);
+    stat.add("expected error at the conicity in use [mm]", 1e3 * err_m);
+  }
+  if (refinements_ > 0) {
+    stat.add("last exact family at conicity", last_refined_conicity_);
+    stat.add("last exact family took [ms]", 1e3 * last_refine_s_);
+  }
+  if (refinement_failures_ > 0) stat.add("last failure", last_refine_error_);
 }
 
 }  // namespace hunting_monitor

@@ -12,6 +12,8 @@
 #include <memory>
 #include <string>
 
+#include "table_refiner.h"
+
 extern "C" {
 #include "hunting_monitor/model.h"
 #include "hunting_monitor/monitor.h"
@@ -39,9 +41,11 @@ class MonitorRos {
   double sensorTime(double stamp, double now);
   void timeJumped(const std::string& what);
   void onTimer(const ros::TimerEvent& ev);
+  void refineTable();
   void publishMarkers(const hm_monitor_status& st, const ros::Time& now);
   void diagnoseInputs(diagnostic_updater::DiagnosticStatusWrapper& stat);
   void diagnoseLevel(diagnostic_updater::DiagnosticStatusWrapper& stat);
+  void diagnoseTable(diagnostic_updater::DiagnosticStatusWrapper& stat);
 
   ros::NodeHandle nh_, pnh_;
   bool ok_ = false;
@@ -58,6 +62,13 @@ class MonitorRos {
   hm_monitor_status last_{};
   bool have_last_ = false;
   int last_published_level_ = -1;
+  // the table's refinement (the core says where, the worker computes, the callbacks never wait)
+  std::unique_ptr<TableRefiner> refiner_;
+  unsigned long refinements_ = 0, refinement_failures_ = 0;
+  double last_refined_conicity_ = 0.0, last_refine_s_ = 0.0, failed_conicity_ = -1.0;
+  std::string last_refine_error_;
+  bool bench_table_churn_ = false;  // ~bench_table_churn: benchmarking only, a refinement every 0.5 s
+  double churn_ = 0.0, next_churn_ = 0.0;
   // time jumps
   double max_clock_offset_s_ = 1.0;
   double last_ros_time_ = 0.0;

@@ -114,13 +114,14 @@ class Robustness(unittest.TestCase):
         self.assert_normal(back[-1])
 
     def test_4_float64_accel_and_speed_in_mps(self):
-        """A second node with accel_type float64 (receipt time) and speed in m/s, on its own topics."""
+        """A second node with accel_type float64 (receipt time) and speed in m/s, on its own topics, and no table
+        file: it computes its table on start (15 conicities) and adds the exact family at the conicity in use (the
+        vehicle's lambda(0) = 0.1358, between two of its curves) in the background."""
         with open(rospy.get_param("~vehicle_config")) as f:
             params = yaml.safe_load(f)
         for section, value in params.items():
             rospy.set_param(f"/plain/{section}", value)
         rospy.set_param("/plain/estimator", {"sample_rate_hz": 200})
-        rospy.set_param("/plain/table_file", rospy.get_param("~table"))
         node = roslib.packages.find_node("hunting_monitor", "hunting_monitor_node")[0]
         proc = subprocess.Popen([node, "__name:=plain", "_accel_type:=float64", "_speed_unit:=mps",
                                  "accel:=plain_accel", "speed:=plain_speed", "hunting_status:=plain_status"],
@@ -144,6 +145,13 @@ class Robustness(unittest.TestCase):
             self.assertAlmostEqual(last.speed_kmh, 360.0, places=6)
             self.assert_normal(last)
             self.assertTrue(last.oscillation_valid and abs(last.frequency_hz - 10.0) < 0.3, last.frequency_hz)
+            first = next(m for m in got if m.boundaries_valid)
+            self.assertEqual(first.table_conicities, 15)  # the computed table (config/monitor.yaml)
+            self.assertGreater(first.table_error_speed_kmh, 0.05)  # interpolated at 0.1358: beyond the tolerance
+            self.assertEqual(last.table_conicities, 16)  # one exact family added...
+            self.assertEqual(last.table_error_speed_kmh, 0.0)  # ...at the conicity in use
+            self.assertAlmostEqual(last.conicity_used, 0.1358, places=9)
+            self.assertAlmostEqual(last.lowest_cycle_speed_kmh, 239.549, delta=0.001)  # the fold (MODEL.md 7)
         finally:
             sub.unregister()
             proc.terminate()

@@ -160,6 +160,46 @@ static void hunting_onset_alarms_within_a_second(void) {
   free(pts);
 }
 
+/* The table's refinement policy: running at 400 km/h with the fallback conicity (the vehicle's 0.1358, between the
+ * small table's curves 0.12 / 0.14 / 0.16) the monitor wants the exact family there; with it swapped in, the lowest
+ * cycle speed in the assessment is the fold itself (MODEL.md section 7: 239.5; the continuation: 239.549) and no
+ * more is wanted; a table of another vehicle is refused and the one in use kept. */
+static void table_refined_at_the_conicity_in_use(void) {
+  run_state r;
+  run_init(&r, 400.0, 0.01, 42, 3);
+  run_segment(&r, 5.0);
+  double c = 0.0;
+  HM_CHECK(r.last.assessment.level != HM_LEVEL_NO_DATA, "no data after 5 s");
+  HM_CHECK(hm_monitor_table_wanted(r.mon, &c) == 1 && c == r.last.assessment.conicity, "refinement wanted at %g", c);
+  HM_CHECK_DELTA(c, 0.1358, 1e-12, "the fallback conicity (the vehicle's lambda(0))");
+  const double before = r.last.assessment.boundaries.lowest_cycle_speed_kmh;
+  hm_table refined = NULL;
+  HM_CHECK(hm_table_refine(hm_monitor_table(r.mon), &vehicle, c, &refined) == HM_OK, "refine");
+  char why[256] = "";
+  HM_CHECK(hm_monitor_replace_table(r.mon, refined, NULL, why, sizeof why) == HM_OK, "replace: %s", why);
+  run_segment(&r, 6.0);
+  const double after = r.last.assessment.boundaries.lowest_cycle_speed_kmh;
+  printf("  lowest cycle speed at 0.1358: interpolated %.4f, refined %.6f km/h\n", before, after);
+  HM_CHECK_DELTA(after, 239.548876, 1e-5, "lowest cycle speed with the exact family (the located fold)");
+  HM_CHECK(hm_monitor_table_wanted(r.mon, &c) == 0, "still wanted after the swap");
+  hm_vehicle other = vehicle;
+  other.stiffness_lat_n_m *= 1.2;
+  /* a table for other stiffnesses (two conicities: quick), offered */
+  hm_table_spec spec;
+  hm_table_spec_default(&spec);
+  spec.conicity_min = 0.12;
+  spec.conicity_max = 0.16;
+  spec.n_conicity = 2;
+  hm_table foreign = NULL;
+  HM_CHECK(hm_table_build(&other, &spec, &foreign) == HM_OK, "foreign table");
+  HM_CHECK(hm_monitor_replace_table(r.mon, foreign, NULL, why, sizeof why) == HM_EDOMAIN && strstr(why, "table made for"),
+           "another vehicle's table accepted: %s", why);
+  HM_CHECK(hm_monitor_table(r.mon) && hm_table_size(hm_monitor_table(r.mon), NULL, NULL) == 4, "the table in use");
+  run_segment(&r, 7.0);
+  HM_CHECK_DELTA(r.last.assessment.boundaries.lowest_cycle_speed_kmh, 239.548876, 1e-5, "still the refined table");
+  run_free(&r);
+}
+
 static int n_seeds = 5;
 
 /* The hunting mode's decay rate identified by the monitor after 45 s at a steady speed (our own simulator: the
@@ -207,6 +247,7 @@ int main(int argc, char **argv) {
   hm_table_destroy(table);
   HM_RUN(below_lowest_cycle_speed_stays_ok);
   HM_RUN(hunting_onset_alarms_within_a_second);
+  HM_RUN(table_refined_at_the_conicity_in_use);
   HM_RUN(decay_rate_on_our_simulator);
   free(table_text);
   HM_TEST_EXIT();

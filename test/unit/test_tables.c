@@ -25,6 +25,24 @@ static void hopf_lookup_is_exact(void) {
   }
 }
 
+enum { CAP = 5000 };
+
+/* The cycle family of the test vehicle (lambda(0) = 0.1358) computed directly with the tables' settings (150-700
+ * km/h, up to 16 mm); *o gets the options used. */
+static hm_cycle_point *direct_family(size_t *np, hm_cycle_event *ev, size_t *ne, hm_cycle_options *o) {
+  hm_hopf_point h;
+  size_t n;
+  HM_CHECK(hm_hopf_find(&vehicle, 500.0, HM_PARAM_SPEED, 100.0, 900.0, 1e-10, &h, 1, &n) == HM_OK && n == 1, "Hopf");
+  hm_cycle_options_default(o, HM_PARAM_SPEED);
+  o->p_min = 150.0;
+  o->p_max = 700.0;
+  o->amp_max_m = 0.016;
+  hm_cycle_point *pts = malloc(CAP * sizeof *pts);
+  *np = *ne = 0;
+  HM_CHECK(hm_cycles_continue(&vehicle, 500.0, &h, o, pts, CAP, np, ev, 16, ne, NULL) == HM_OK, "family");
+  return pts;
+}
+
 /* At lambda(0) = 0.1358 (between grid points): MODEL.md section 7 and a direct continuation agree with the
  * lookup within the table's stated errors. */
 static void lookup_matches_direct_continuation(void) {
@@ -37,19 +55,10 @@ static void lookup_matches_direct_continuation(void) {
   HM_CHECK(r.has_edge && r.consistent, "an edge at 420 km/h");
   HM_CHECK_DELTA(r.edge_amp_m, 8.2e-3, 0.1e-3, "edge at 420 km/h (MODEL: about 8.2 mm)");
   /* direct: the family at lambda(0) = 0.1358 */
-  hm_hopf_point h;
-  size_t n;
-  HM_CHECK(hm_hopf_find(&vehicle, 500.0, HM_PARAM_SPEED, 100.0, 900.0, 1e-10, &h, 1, &n) == HM_OK && n == 1, "Hopf");
   hm_cycle_options o;
-  hm_cycle_options_default(&o, HM_PARAM_SPEED);
-  o.p_min = 150.0;
-  o.p_max = 700.0;
-  o.amp_max_m = 0.016;
-  enum { CAP = 5000 };
-  hm_cycle_point *pts = malloc(CAP * sizeof *pts);
   hm_cycle_event ev[16];
   size_t np = 0, ne = 0;
-  HM_CHECK(hm_cycles_continue(&vehicle, 500.0, &h, &o, pts, CAP, &np, ev, 16, &ne, NULL) == HM_OK, "family");
+  hm_cycle_point *pts = direct_family(&np, ev, &ne, &o);
   const double speeds[] = {300.0, 400.0, 480.0};
   for (int k = 0; k < 3; ++k) {
     double edge = INFINITY;
@@ -240,6 +249,71 @@ static void parallel_build_equals_sequential(void) {
   free(ref);
 }
 
+/* A table refined at lambda(0) = 0.1358 (between its grid points) gives there the lowest cycle speed of the family
+ * computed directly (its located fold, hm_cycles_lowest) and the unstable cycle that Newton finds at the speed;
+ * the expected local error is zero there and largest mid-interval; the original table is untouched; a conicity
+ * outside the table, on a curve, or another vehicle is refused. */
+static void refined_table_is_exact_at_its_new_curve(void) {
+  char *before = format(table);
+  double e_mid_v, e_mid_a, e_node_v, e_node_a;
+  HM_CHECK(hm_table_local_error(table, 0.13, &e_mid_v, &e_mid_a) == HM_OK, "local error mid-interval");
+  HM_CHECK(hm_table_local_error(table, 0.14, &e_node_v, &e_node_a) == HM_OK, "local error on a curve");
+  hm_table_lookup_result g;
+  hm_table_lookup(table, 0.13, 400.0, &g);
+  printf("  expected error mid-interval %.3f km/h %.4f mm (stated %.3f km/h), on a curve %.2g km/h\n", e_mid_v,
+         e_mid_a * 1e3, g.error_speed_kmh, e_node_v);
+  HM_CHECK_DELTA(e_mid_v, g.error_speed_kmh, 1e-12, "mid-interval: the measured error");
+  HM_CHECK(e_node_v == 0.0 && e_node_a == 0.0, "on a curve: no interpolation error");
+  hm_table r = NULL;
+  HM_CHECK(hm_table_refine(table, &vehicle, 0.1358, &r) == HM_OK && r, "refine");
+  if (!r) {
+    free(before);
+    return;
+  }
+  /* direct: the family at lambda(0) = 0.1358 with the table's settings */
+  hm_cycle_options o;
+  hm_cycle_event ev[16];
+  size_t np = 0, ne = 0;
+  hm_cycle_point *pts = direct_family(&np, ev, &ne, &o);
+  hm_table_lookup_result a, b;
+  HM_CHECK(hm_table_lookup(table, 0.1358, 400.0, &a) == HM_OK && hm_table_lookup(r, 0.1358, 400.0, &b) == HM_OK,
+           "lookups");
+  const double lowest = hm_cycles_lowest(pts, np, ev, ne);
+  printf("  lowest cycle speed: direct %.6f, refined table %.6f, original table %.6f km/h\n", lowest,
+         b.lowest_cycle_speed_kmh, a.lowest_cycle_speed_kmh);
+  HM_CHECK_DELTA(b.lowest_cycle_speed_kmh, lowest, 1e-6, "refined: lowest cycle speed");
+  /* the unstable cycle at 400 km/h by Newton from the branch point nearest in speed among the unstable ones */
+  const hm_cycle_point *near = NULL;
+  for (size_t i = 0; i < np; ++i)
+    if (!pts[i].stable && pts[i].amp_y_m < 0.0095 && pts[i].param < 505.0 &&
+        (!near || fabs(pts[i].param - 400.0) < fabs(near->param - 400.0)))
+      near = &pts[i];
+  hm_cycle_point exact;
+  HM_CHECK(near && hm_cycle_solve(&vehicle, 500.0, &o, 400.0, near->x0, near->period_s, &exact) == HM_OK,
+           "cycle at 400 km/h");
+  if (near) {
+    printf("  unstable cycle at 400 km/h: Newton %.5f mm, refined table %.5f mm, original %.5f mm\n",
+           exact.amp_y_m * 1e3, b.edge_amp_m * 1e3, a.edge_amp_m * 1e3);
+    /* the table keeps the branch within 1 um (its decimation); the polyline's chord error adds about that */
+    HM_CHECK_DELTA(b.edge_amp_m, exact.amp_y_m, 3e-6, "refined: unstable cycle at 400 km/h");
+  }
+  double e_v, e_a;
+  HM_CHECK(hm_table_local_error(r, 0.1358, &e_v, &e_a) == HM_OK && e_v == 0.0 && e_a == 0.0, "refined: exact");
+  HM_CHECK(hm_table_size(r, NULL, NULL) == hm_table_size(table, NULL, NULL) + 1, "one curve more");
+  char *after = format(table);
+  HM_CHECK(before && after && strcmp(before, after) == 0, "the original table changed");
+  hm_table x = NULL;
+  HM_CHECK(hm_table_refine(table, &vehicle, 0.5, &x) == HM_EDOMAIN && !x, "outside");
+  HM_CHECK(hm_table_refine(table, &vehicle, 0.14, &x) == HM_EDOMAIN && !x, "on a curve");
+  hm_vehicle other = vehicle;
+  other.stiffness_long_n_m *= 1.1;
+  HM_CHECK(hm_table_refine(table, &other, 0.1358, &x) == HM_EDOMAIN && !x, "another vehicle");
+  free(pts);
+  free(before);
+  free(after);
+  hm_table_destroy(r);
+}
+
 int main(void) {
   hm_vehicle_default(&vehicle);
   if (hm_test_small_table(&table) != HM_OK) {
@@ -252,6 +326,7 @@ int main(void) {
   HM_RUN(malformed_tables);
   HM_RUN(table_checked_against_vehicle);
   HM_RUN(parallel_build_equals_sequential);
+  HM_RUN(refined_table_is_exact_at_its_new_curve);
   hm_table_destroy(table);
   HM_TEST_EXIT();
 }
