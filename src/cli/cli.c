@@ -226,7 +226,7 @@ void jw_number(json_writer *w, const char *key, double value) {
     fputs("null", w->f);
     return;
   }
-  char buf[32];
+  char buf[400]; /* room for any precision as the compiler sees it (at most 17 digits are used) */
   /* the shortest that reads back as the same double, without an exponent for whole numbers below 1e15 */
   const double mag = fabs(value);
   const int digits = mag >= 1.0 && mag < 1e15 ? (int)floor(log10(mag)) + 1 : 1;
