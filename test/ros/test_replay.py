@@ -2,8 +2,11 @@
 """Bag replay: level sequence and timing, margins against the offline reference (`hunting estimate`), status
 rate, diagnostics, markers and the latched alarm."""
 import bisect
+import csv
 import json
+import os
 import subprocess
+import tempfile
 import threading
 import time
 import unittest
@@ -52,6 +55,37 @@ class Replay(unittest.TestCase):
 
     def data_statuses(self):
         return [m for m in self.status if T0 + 1.5 <= m.header.stamp.to_sec() <= T0 + DURATION - 0.1]
+
+    def test_bag_to_csv_for_offline_analysis(self):
+        """scripts/bag_to_csv gives back the samples the bag was made from (scripts/make_test_bag's CSVs, at bag time
+        T0 + t), and `hunting estimate` on its CSVs agrees with the node's levels as on the originals."""
+        data = rospy.get_param("~data_dir")
+        script = os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "..", "scripts", "bag_to_csv")
+        with tempfile.TemporaryDirectory() as d:
+            subprocess.run(["/usr/bin/python3", script, data + "/ramp.bag", d], check=True, capture_output=True)
+            for name in ("accel.csv", "speed.csv"):
+                with open(os.path.join(data, name)) as f:
+                    orig = [tuple(map(float, r)) for r in list(csv.reader(f))[1:]]
+                with open(os.path.join(d, name)) as f:
+                    conv = [tuple(map(float, r)) for r in list(csv.reader(f))[1:]]
+                self.assertEqual(len(conv), len(orig), name)
+                self.assertLess(max(abs(c[0] - T0 - o[0]) for c, o in zip(conv, orig)), 2e-6, name + " times")
+                self.assertEqual([c[1] for c in conv], [o[1] for o in orig], name + " values")
+            out = subprocess.run([rospy.get_param("~hunting"), "estimate", "--accel", d + "/accel.csv", "--speed",
+                                  d + "/speed.csv", "--table", rospy.get_param("~table"), "--every", "0.05"],
+                                 capture_output=True, text=True, check=True).stdout
+        again = [json.loads(line) for line in out.splitlines() if line.strip()]
+        times = [r["t_s"] for r in again]
+        n = agree = 0
+        for m in self.data_statuses():
+            t = m.header.stamp.to_sec()  # the converted CSVs are in bag time
+            i = bisect.bisect_left(times, t)
+            r = min((again[j] for j in (i - 1, i) if 0 <= j < len(times)), key=lambda c: abs(c["t_s"] - t))
+            if abs(r["t_s"] - t) <= 0.05:
+                n += 1
+                agree += LEVELS[m.level] == r["level"]
+        self.assertGreater(n, 400, "too few matched status messages")
+        self.assertGreaterEqual(agree / n, 0.95, f"levels agree in {agree}/{n}")
 
     def test_replay_covers_the_bag(self):
         self.assertTrue(self.status, "no hunting_status received")
