@@ -40,7 +40,7 @@ void hm_monitor_config_default(hm_monitor_config *c) {
   hm_modal_config_default(&c->modal);
   hm_margin_config_default(&c->margin);
   hm_alarm_config_default(&c->alarm);
-  c->table_n_conicity = 15;
+  c->table_n_conicity = 36;
   c->table.refine = 1;
   c->table.tolerance_kmh = 0.05;
   c->table.tolerance_m = 5e-6;

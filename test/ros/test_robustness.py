@@ -115,7 +115,7 @@ class Robustness(unittest.TestCase):
 
     def test_4_float64_accel_and_speed_in_mps(self):
         """A second node with accel_type float64 (receipt time) and speed in m/s, on its own topics, and no table
-        file: it computes its table on start (15 conicities) and adds the exact family at the conicity in use (the
+        file: it computes its table on start (36 conicities) and adds the exact family at the conicity in use (the
         vehicle's lambda(0) = 0.1358, between two of its curves) in the background."""
         with open(rospy.get_param("~vehicle_config")) as f:
             params = yaml.safe_load(f)
@@ -146,9 +146,9 @@ class Robustness(unittest.TestCase):
             self.assert_normal(last)
             self.assertTrue(last.oscillation_valid and abs(last.frequency_hz - 10.0) < 0.3, last.frequency_hz)
             first = next(m for m in got if m.boundaries_valid)
-            self.assertEqual(first.table_conicities, 15)  # the computed table (config/monitor.yaml)
+            self.assertEqual(first.table_conicities, 36)  # the computed table (hm_monitor_config_default)
             self.assertGreater(first.table_error_speed_kmh, 0.05)  # interpolated at 0.1358: beyond the tolerance
-            self.assertEqual(last.table_conicities, 16)  # one exact family added...
+            self.assertEqual(last.table_conicities, 37)  # one exact family added...
             self.assertEqual(last.table_error_speed_kmh, 0.0)  # ...at the conicity in use
             self.assertAlmostEqual(last.conicity_used, 0.1358, places=9)
             self.assertAlmostEqual(last.lowest_cycle_speed_kmh, 239.549, delta=0.001)  # the fold (MODEL.md 7)
