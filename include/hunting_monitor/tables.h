@@ -114,6 +114,21 @@ hm_status hm_table_local_error(const hm_table t, double conicity, double *err_sp
  * HM_EDOMAIN for a conicity outside the table or on one of its curves. */
 hm_status hm_table_refine(const hm_table t, const hm_vehicle *veh, double conicity, hm_table *out);
 
+/* A point of a cycle family as the table holds it (the polyline from the Hopf point on). */
+typedef struct {
+  double speed_kmh;
+  double amp_m;       /* max |y| of the cycle */
+  int stable;         /* the segment from this point to the next is of stable cycles */
+  int fold;           /* a turning point in speed (a fold of cycles, LPC) */
+} hm_family_point;
+
+/* The cycle family at a conicity, for display: the table's own curve when it has one there (*exact = 1), else the
+ * nearest curve's with its speeds scaled by the ratio of the Hopf speeds (Klingel: V ~ 1/sqrt(lambda)), as lookups
+ * compare neighbours at the same fraction of their Hopf speeds (*exact = 0). Writes up to max points, *n the
+ * number the family has. HM_EDOMAIN outside the table's conicities or for non-finite input. */
+hm_status hm_table_family(const hm_table t, double conicity, hm_family_point *points, size_t max, size_t *n,
+                          int *exact);
+
 /* Number of conicities and the range, for reporting. */
 size_t hm_table_size(const hm_table t, double *conicity_min, double *conicity_max);
 

@@ -358,6 +358,30 @@ hm_status hm_table_build_parallel(const hm_vehicle *veh, const hm_table_spec *sp
   return HM_OK;
 }
 
+hm_status hm_table_family(const hm_table t, double conicity, hm_family_point *points, size_t max, size_t *n,
+                          int *exact) {
+  if (!t || t->n < 2 || !n || !exact || (max && !points)) return HM_EINVAL;
+  if (!isfinite(conicity) || conicity < t->curves[0].conicity || conicity > t->curves[t->n - 1].conicity)
+    return HM_EDOMAIN;
+  const size_t i = interval_of(t, conicity);
+  const tcurve *a = &t->curves[i], *b = &t->curves[i + 1];
+  const tcurve *c = conicity - a->conicity <= b->conicity - conicity ? a : b;
+  hm_table_lookup_result r;
+  const hm_status st = hm_table_lookup(t, conicity, t->speed_min_kmh, &r);
+  if (st != HM_OK) return st;
+  const double scale = r.hopf_speed_kmh / c->hopf_kmh;
+  for (size_t k = 0; k < c->n && k < max; ++k) {
+    const double dv0 = k > 0 ? c->pts[k].v_kmh - c->pts[k - 1].v_kmh : 0.0;
+    const double dv1 = k + 1 < c->n ? c->pts[k + 1].v_kmh - c->pts[k].v_kmh : 0.0;
+    const int stable = c->pts[k].stable && (k + 1 == c->n || c->pts[k + 1].stable); /* as cycles_of reads it */
+    points[k] = (hm_family_point){c->pts[k].v_kmh * scale, c->pts[k].amp_m, stable,
+                                  dv0 != 0.0 && dv1 != 0.0 && (dv0 > 0.0) != (dv1 > 0.0)};
+  }
+  *n = c->n;
+  *exact = c->conicity == conicity;
+  return HM_OK;
+}
+
 hm_status hm_table_local_error(const hm_table t, double conicity, double *err_speed_kmh, double *err_amp_m) {
   if (!t || t->n < 2 || !err_speed_kmh || !err_amp_m) return HM_EINVAL;
   if (!isfinite(conicity)) return HM_EDOMAIN;

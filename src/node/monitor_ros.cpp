@@ -31,6 +31,8 @@ MonitorRos::MonitorRos(ros::NodeHandle nh, ros::NodeHandle pnh) : nh_(nh), pnh_(
   status_pub_ = nh_.advertise<hunting_monitor::HuntingStatus>("hunting_status", 50);
   alarm_pub_ = nh_.advertise<std_msgs::UInt8>("hunting_alarm", 1, true);
   marker_pub_ = nh_.advertise<visualization_msgs::MarkerArray>("hunting_markers", 5);
+  chart_pub_ = nh_.advertise<visualization_msgs::MarkerArray>("hunting_chart", 5);
+  chart_.reset(new StabilityChart(frame_id_));
   updater_.setHardwareID("hunting_monitor");
   accel_min_hz_ = 0.9 * cfg_.estimator.sample_rate_hz;
   accel_max_hz_ = 1.1 * cfg_.estimator.sample_rate_hz;
@@ -323,6 +325,8 @@ void MonitorRos::onTimer(const ros::TimerEvent&) {
              e.speed_kmh);
   }
   publishMarkers(st, now);
+  const visualization_msgs::MarkerArray chart = chart_->update(st, hm_monitor_table(monitor_), now);
+  if (!chart.markers.empty()) chart_pub_.publish(chart);
   updater_.update();
 }
 

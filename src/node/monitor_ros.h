@@ -12,6 +12,7 @@
 #include <memory>
 #include <string>
 
+#include "stability_chart.h"
 #include "table_refiner.h"
 
 extern "C" {
@@ -79,7 +80,8 @@ class MonitorRos {
   double last_jump_at_ = -1e300;
   // ROS
   ros::Subscriber accel_sub_, speed_sub_;
-  ros::Publisher status_pub_, alarm_pub_, marker_pub_;
+  ros::Publisher status_pub_, alarm_pub_, marker_pub_, chart_pub_;
+  std::unique_ptr<StabilityChart> chart_;
   ros::Timer timer_;
   diagnostic_updater::Updater updater_;
   double accel_min_hz_ = 0.0, accel_max_hz_ = 0.0;

@@ -24,7 +24,7 @@ LEVELS = ["NO_DATA", "OK", "WATCH", "WARN", "ALARM"]
 
 
 class Replay(unittest.TestCase):
-    status, diagnostics, markers = [], [], []
+    status, diagnostics, markers, chart = [], [], [], []
     reference = []
 
     @classmethod
@@ -40,6 +40,7 @@ class Replay(unittest.TestCase):
         rospy.Subscriber("hunting_status", HuntingStatus, keep(cls.status), queue_size=1000)
         rospy.Subscriber("/diagnostics", DiagnosticArray, keep(cls.diagnostics), queue_size=100)
         rospy.Subscriber("hunting_markers", MarkerArray, keep(cls.markers), queue_size=100)
+        rospy.Subscriber("hunting_chart", MarkerArray, keep(cls.chart), queue_size=1000)
         deadline = time.time() + 150.0
         while time.time() < deadline:
             with lock:
@@ -141,6 +142,30 @@ class Replay(unittest.TestCase):
         self.assertIn(2, levels, "ALARM maps to diagnostic ERROR")
         self.assertTrue(self.markers and len(self.markers[-1].markers) == 2)
         self.assertEqual(self.markers[-1].markers[0].header.frame_id, "base_link")
+
+    def test_stability_chart(self):
+        """The chart's family is the table's at the conicity in use (refined there: exact), drawn at 1 m per 100 km/h
+        from x = 1.5 m: the Hopf point at 517.618 and the folds of MODEL.md section 7 (515.691, 516.353, 239.549 km/h)
+        are where the speeds put them; the operating point stays inside the axes; the family is redrawn only when
+        the conicity or table changes (or every 5 s), not with every status."""
+        x = lambda v: 1.5 + 0.01 * v  # noqa: E731
+        families = [a for a in self.chart if any(m.ns == "chart_family" for m in a.markers)]
+        self.assertTrue(families, "no family drawn")
+        self.assertLess(len(families), len(self.chart) / 10, "the family is redrawn with every status")
+        last = families[-1]
+        lines = [m for m in last.markers if m.ns == "chart_family" and m.type == m.LINE_LIST]
+        self.assertTrue(lines and sum(len(m.points) for m in lines) >= 20, "no branch lines")
+        marks = next(m for m in last.markers if m.ns == "chart_family" and m.type == m.SPHERE_LIST)
+        self.assertAlmostEqual(marks.points[0].x, x(517.618), delta=1e-4)  # the Hopf point at amplitude 0
+        self.assertAlmostEqual(marks.points[0].z, 0.0, delta=1e-9)
+        folds = sorted(p.x for p in marks.points[1:])
+        for v in (239.549, 515.691, 516.353):
+            self.assertTrue(any(abs(f - x(v)) < 2e-4 for f in folds), f"no fold at {v} km/h: {folds}")
+        title = next(m.text for m in last.markers if m.ns == "chart_labels" and m.text.startswith("cycles at"))
+        self.assertIn("exact family", title)
+        points = [m.pose.position for a in self.chart for m in a.markers if m.ns == "chart_now" and m.id == 0]
+        self.assertTrue(points, "no operating point")
+        self.assertTrue(all(1.5 <= p.x <= 8.5 and 0.0 <= p.z <= 4.0 for p in points), "operating point off the chart")
 
     def test_alarm_is_latched(self):
         got = []

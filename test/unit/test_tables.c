@@ -275,6 +275,9 @@ static void refined_table_is_exact_at_its_new_curve(void) {
   hm_cycle_event ev[16];
   size_t np = 0, ne = 0;
   hm_cycle_point *pts = direct_family(&np, ev, &ne, &o);
+  hm_hopf_point h;
+  size_t nh = 0;
+  HM_CHECK(hm_hopf_find(&vehicle, 500.0, HM_PARAM_SPEED, 100.0, 900.0, 1e-10, &h, 1, &nh) == HM_OK, "Hopf");
   hm_table_lookup_result a, b;
   HM_CHECK(hm_table_lookup(table, 0.1358, 400.0, &a) == HM_OK && hm_table_lookup(r, 0.1358, 400.0, &b) == HM_OK,
            "lookups");
@@ -297,6 +300,27 @@ static void refined_table_is_exact_at_its_new_curve(void) {
     /* the table keeps the branch within 1 um (its decimation); the polyline's chord error adds about that */
     HM_CHECK_DELTA(b.edge_amp_m, exact.amp_y_m, 3e-6, "refined: unstable cycle at 400 km/h");
   }
+  /* the family for display: exact on the refined table, its folds those the continuation located */
+  hm_family_point fam[4096];
+  size_t nf = 0;
+  int on_curve = 0;
+  HM_CHECK(hm_table_family(r, 0.1358, fam, 4096, &nf, &on_curve) == HM_OK && on_curve && nf > 2 && nf <= 4096, "family");
+  HM_CHECK_DELTA(fam[0].speed_kmh, h.speed_kmh, 1e-9, "the family starts at the Hopf point");
+  HM_CHECK(fam[0].amp_m == 0.0, "at amplitude 0");
+  size_t n_folds = 0, matched = 0;
+  for (size_t k = 0; k < nf; ++k) {
+    if (!fam[k].fold) continue;
+    ++n_folds;
+    for (size_t j = 0; j < ne; ++j)
+      matched += ev[j].kind == HM_CYCLE_LPC && fabs(ev[j].point.param - fam[k].speed_kmh) < 1e-6;
+  }
+  size_t n_lpc = 0;
+  for (size_t j = 0; j < ne; ++j) n_lpc += ev[j].kind == HM_CYCLE_LPC;
+  HM_CHECK(n_folds == n_lpc && matched == n_lpc && n_lpc == 3, "folds in the family %zu, located %zu, matched %zu",
+           n_folds, n_lpc, matched);
+  HM_CHECK(hm_table_family(table, 0.1358, fam, 4096, &nf, &on_curve) == HM_OK && !on_curve, "interpolated family");
+  HM_CHECK_DELTA(fam[0].speed_kmh, h.speed_kmh, 1e-9, "scaled to the Hopf speed at 0.1358");
+  HM_CHECK(hm_table_family(table, 0.5, fam, 4096, &nf, &on_curve) == HM_EDOMAIN, "outside");
   double e_v, e_a;
   HM_CHECK(hm_table_local_error(r, 0.1358, &e_v, &e_a) == HM_OK && e_v == 0.0 && e_a == 0.0, "refined: exact");
   HM_CHECK(hm_table_size(r, NULL, NULL) == hm_table_size(table, NULL, NULL) + 1, "one curve more");
