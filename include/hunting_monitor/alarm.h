@@ -115,6 +115,10 @@ hm_status hm_alarm_create(const hm_alarm_config *cfg, const hm_vehicle *veh, con
 void hm_alarm_destroy(hm_alarm alarm);
 /* Back to NO_DATA / starting (the stream was restarted). */
 void hm_alarm_reset(hm_alarm alarm);
+/* New settings from the next update on, the level and its hold kept (validated as at create: HM_EDOMAIN with the
+ * reason in why, and nothing changes); the fallback conicity 0 becomes veh's lambda(0). */
+hm_status hm_alarm_set_config(hm_alarm alarm, const hm_alarm_config *cfg, const hm_vehicle *veh, char *why,
+                              size_t why_len);
 /* Look boundaries up in this table from the next update on (borrowed, as at create; the level is kept). */
 void hm_alarm_set_table(hm_alarm alarm, const hm_table table);
 

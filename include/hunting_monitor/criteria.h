@@ -45,6 +45,8 @@ void hm_criteria_restart(hm_criteria c, double fs_hz);
  * metres the track covered since the previous sample. */
 void hm_criteria_push(hm_criteria c, double band_x, double raw_a, double metres);
 void hm_criteria_read(const hm_criteria c, hm_criteria_state *out);
+/* New limits from the next read on (the caller validated them: hm_estimator_config_validate); the state is kept. */
+void hm_criteria_set_limits(hm_criteria c, double rms_limit_mps2, double peaks_limit_mps2, unsigned peaks_count);
 
 #ifdef __cplusplus
 }

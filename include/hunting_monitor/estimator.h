@@ -120,6 +120,10 @@ hm_status hm_estimator_create(const hm_estimator_config *cfg, hm_estimator *out,
 void hm_estimator_destroy(hm_estimator est);
 /* Forget all state (filters, trackers, counters). */
 void hm_estimator_reset(hm_estimator est);
+/* The standard criteria's limits while running (rms_limit_mps2, peaks_limit_mps2, peaks_count of cfg; its other
+ * fields are ignored), validated as hm_estimator_config_validate does (HM_EDOMAIN with the reason; nothing changes
+ * then). The stream's state is kept. */
+hm_status hm_estimator_set_limits(hm_estimator est, const hm_estimator_config *cfg, char *why, size_t why_len);
 /* How many times the filters restarted (gaps, redesigns for a measured rate, resets), and the rate they are designed
  * for now: a consumer of the same stream (the modal identification) restarts with them. */
 unsigned long hm_estimator_restarts(const hm_estimator est, double *design_rate_hz);

@@ -87,6 +87,14 @@ hm_status hm_monitor_push_speed(hm_monitor m, double t_s, double speed_kmh);
 /* Evaluate at now_s. HM_EINVAL for NULL or non-finite now; out untouched on failure. */
 hm_status hm_monitor_update(hm_monitor m, double now_s, hm_monitor_status *out);
 
+/* The settings that may change while monitoring (commissioning): the alarm's (cfg->alarm: margins, hysteresis,
+ * hold time, use of the conicity estimate) and the standard criteria's limits (cfg->estimator.rms_limit_mps2,
+ * peaks_limit_mps2, peaks_count); cfg's other fields are ignored (they need a new monitor). Validated as a whole
+ * with the running settings (HM_EDOMAIN, "section.field: reason" in why): on failure nothing changes. The level
+ * and the stream's state are kept. hm_monitor_settings gives the running configuration. */
+hm_status hm_monitor_set_runtime_settings(hm_monitor m, const hm_monitor_config *cfg, char *why, size_t why_len);
+void hm_monitor_settings(const hm_monitor m, hm_monitor_config *cfg);
+
 /* The table in use (borrowed, valid until the next hm_monitor_replace_table), e.g. for reporting its range and
  * errors, or to refine (hm_table_refine only reads it). */
 hm_table hm_monitor_table(const hm_monitor m);

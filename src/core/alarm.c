@@ -109,6 +109,17 @@ void hm_alarm_reset(hm_alarm a) {
   a->have_lookup = 0;
 }
 
+hm_status hm_alarm_set_config(hm_alarm a, const hm_alarm_config *cfg, const hm_vehicle *veh, char *why,
+                              size_t why_len) {
+  if (!a || !cfg || !veh) return HM_EINVAL;
+  const hm_status st = hm_alarm_config_validate(cfg, why, why_len);
+  if (st != HM_OK) return st;
+  a->cfg = *cfg;
+  if (a->cfg.conicity_fallback == 0.0) hm_conicity_eval(&veh->conicity, 0.0, &a->cfg.conicity_fallback, NULL);
+  a->have_lookup = 0; /* the conicity in use may change with the settings */
+  return HM_OK;
+}
+
 void hm_alarm_set_table(hm_alarm a, const hm_table table) {
   if (!a || !table) return;
   a->table = table;

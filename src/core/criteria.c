@@ -116,3 +116,10 @@ void hm_criteria_read(const hm_criteria c, hm_criteria_state *out) {
   r.peaks_exceeded = c->consecutive >= c->cfg.peaks_count;
   *out = r;
 }
+
+void hm_criteria_set_limits(hm_criteria c, double rms_limit_mps2, double peaks_limit_mps2, unsigned peaks_count) {
+  if (!c) return;
+  c->cfg.rms_limit_mps2 = rms_limit_mps2;
+  c->cfg.peaks_limit_mps2 = peaks_limit_mps2;
+  c->cfg.peaks_count = peaks_count;
+}

@@ -203,6 +203,19 @@ hm_status hm_estimator_create(const hm_estimator_config *cfg, hm_estimator *out,
   return HM_OK;
 }
 
+hm_status hm_estimator_set_limits(hm_estimator e, const hm_estimator_config *cfg, char *why, size_t len) {
+  if (!e || !cfg) return HM_EINVAL;
+  hm_estimator_config c = e->cfg;
+  c.rms_limit_mps2 = cfg->rms_limit_mps2;
+  c.peaks_limit_mps2 = cfg->peaks_limit_mps2;
+  c.peaks_count = cfg->peaks_count;
+  const hm_status st = hm_estimator_config_validate(&c, why, len);
+  if (st != HM_OK) return st;
+  e->cfg = c;
+  hm_criteria_set_limits(e->criteria, c.rms_limit_mps2, c.peaks_limit_mps2, c.peaks_count);
+  return HM_OK;
+}
+
 unsigned long hm_estimator_restarts(const hm_estimator e, double *design_rate_hz) {
   if (!e) return 0;
   if (design_rate_hz) *design_rate_hz = e->design_rate_hz;

@@ -267,6 +267,26 @@ hm_status hm_monitor_update(hm_monitor m, double now, hm_monitor_status *out) {
 
 hm_table hm_monitor_table(const hm_monitor m) { return m ? m->table : NULL; }
 
+hm_status hm_monitor_set_runtime_settings(hm_monitor m, const hm_monitor_config *cfg, char *why, size_t len) {
+  if (!m || !cfg) return HM_EINVAL;
+  hm_monitor_config c = m->cfg;
+  c.alarm = cfg->alarm;
+  c.estimator.rms_limit_mps2 = cfg->estimator.rms_limit_mps2;
+  c.estimator.peaks_limit_mps2 = cfg->estimator.peaks_limit_mps2;
+  c.estimator.peaks_count = cfg->estimator.peaks_count;
+  hm_status st = hm_monitor_config_validate(&c, why, len);
+  if (st != HM_OK) return st;
+  /* both parts were validated above, so neither setter can fail half-way */
+  if ((st = hm_estimator_set_limits(m->est, &c.estimator, why, len)) != HM_OK) return st;
+  if ((st = hm_alarm_set_config(m->alarm, &c.alarm, &m->veh, why, len)) != HM_OK) return st;
+  m->cfg = c;
+  return HM_OK;
+}
+
+void hm_monitor_settings(const hm_monitor m, hm_monitor_config *cfg) {
+  if (m && cfg) *cfg = m->cfg;
+}
+
 int hm_monitor_table_wanted(const hm_monitor m, double *conicity) {
   if (!m || !conicity || !m->cfg.table.refine || !isfinite(m->conicity_in_use)) return 0;
   double lo, hi, e_kmh, e_m;

@@ -200,6 +200,49 @@ static void table_refined_at_the_conicity_in_use(void) {
   run_free(&r);
 }
 
+/* Settings changed while monitoring (commissioning): at 480 km/h (OK: 37.6 km/h below the Hopf speed, WATCH starts
+ * 30 km/h below the interval) a 40 km/h WATCH margin makes the next status WATCH; an invalid value is refused with
+ * its reason and the running settings kept; a criterion limit below the running r.m.s. gives the criterion's ALARM;
+ * a field that needs a new monitor (the sample rate) is not taken over. */
+static void settings_changed_while_running(void) {
+  run_state r;
+  run_init(&r, 480.0, 0.01, 42, 4);
+  run_segment(&r, 5.0);
+  HM_CHECK(r.last.assessment.level == HM_LEVEL_OK, "level %s before", hm_level_name(r.last.assessment.level));
+  hm_monitor_config c;
+  hm_monitor_settings(r.mon, &c);
+  c.alarm.watch_speed_margin_kmh = 40.0;
+  c.estimator.sample_rate_hz = 500.0; /* ignored: needs a new monitor */
+  char why[256] = "";
+  HM_CHECK(hm_monitor_set_runtime_settings(r.mon, &c, why, sizeof why) == HM_OK, "valid change: %s", why);
+  run_segment(&r, 5.2);
+  HM_CHECK(r.last.assessment.level == HM_LEVEL_WATCH && r.last.assessment.reason == HM_REASON_APPROACHING_HOPF,
+           "level %s after the WATCH margin went to 40 km/h", hm_level_name(r.last.assessment.level));
+  hm_monitor_config now;
+  hm_monitor_settings(r.mon, &now);
+  HM_CHECK(now.alarm.watch_speed_margin_kmh == 40.0 && now.estimator.sample_rate_hz == 2000.0, "running settings");
+  hm_monitor_config bad = now;
+  bad.alarm.hysteresis_kmh = -1.0;
+  HM_CHECK(hm_monitor_set_runtime_settings(r.mon, &bad, why, sizeof why) == HM_EDOMAIN &&
+               strstr(why, "alarm.hysteresis_kmh") != NULL,
+           "invalid change accepted or unexplained: %s", why);
+  hm_monitor_settings(r.mon, &now);
+  HM_CHECK(now.alarm.hysteresis_kmh == c.alarm.hysteresis_kmh, "the refused value was applied");
+  bad = now;
+  bad.estimator.peaks_count = 0;
+  HM_CHECK(hm_monitor_set_runtime_settings(r.mon, &bad, why, sizeof why) == HM_EDOMAIN && strstr(why, "peaks_count"),
+           "peaks_count 0 accepted: %s", why);
+  const double rms = r.last.estimate.rms_mps2;
+  c = now;
+  c.estimator.rms_limit_mps2 = 0.5 * rms;
+  HM_CHECK(rms > 0.0 && hm_monitor_set_runtime_settings(r.mon, &c, why, sizeof why) == HM_OK, "rms limit: %s", why);
+  run_segment(&r, 5.4);
+  HM_CHECK(r.last.assessment.level == HM_LEVEL_ALARM && r.last.assessment.reason == HM_REASON_RMS_CRITERION,
+           "rms %.3f over a limit of %.3f m/s^2 gave %s", r.last.estimate.rms_mps2, 0.5 * rms,
+           hm_level_name(r.last.assessment.level));
+  run_free(&r);
+}
+
 static int n_seeds = 5;
 
 /* The hunting mode's decay rate identified by the monitor after 45 s at a steady speed (our own simulator: the
@@ -248,6 +291,7 @@ int main(int argc, char **argv) {
   HM_RUN(below_lowest_cycle_speed_stays_ok);
   HM_RUN(hunting_onset_alarms_within_a_second);
   HM_RUN(table_refined_at_the_conicity_in_use);
+  HM_RUN(settings_changed_while_running);
   HM_RUN(decay_rate_on_our_simulator);
   free(table_text);
   HM_TEST_EXIT();
