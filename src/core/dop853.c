@@ -123,7 +123,7 @@ static hm_status try_step(hm_dop853 d, const hm_ode_system *sys, const hm_dopri_
     if (ER[j] != 0.0)
       for (size_t c = 0; c < n; ++c) esum[c] += ER[j] * kj[c];
   }
-  const size_t m = opt->err_dim && opt->err_dim < n ? opt->err_dim : n;
+  const size_t m = hm_rk_err_dim(opt, n);
   double e5 = 0.0, e3 = 0.0;
   int finite = 1;
   for (size_t c = 0; c < n; ++c) {
@@ -183,7 +183,7 @@ hm_status hm_dop853_integrate(hm_dop853 d, const hm_ode_system *sys, const hm_do
      * components' weighted norm; Hairer's heuristic without its probe step) */
     double h = opt->h_init;
     if (!(h > 0.0)) {
-      const size_t m = opt->err_dim && opt->err_dim < n ? opt->err_dim : n;
+      const size_t m = hm_rk_err_dim(opt, n);
       double dx = 0.0, df = 0.0;
       for (size_t c = 0; c < m; ++c) {
         const double sk = opt->atol + opt->rtol * fabs(d->x[c]);

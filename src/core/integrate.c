@@ -177,16 +177,17 @@ static hm_status dopri_try(hm_dopri d, const hm_ode_system *sys, double t, doubl
 }
 
 /* Weighted RMS norm of the error estimate; +inf if anything is not finite. */
-static double dopri_error_norm(const hm_dopri d, double rtol, double atol, size_t err_dim) {
+static double dopri_error_norm(const hm_dopri d, const hm_dopri_options *opt) {
   double s = 0.0;
-  const size_t m = err_dim && err_dim < d->dim ? err_dim : d->dim;
+  const size_t m = hm_rk_err_dim(opt, d->dim);
   for (size_t i = 0; i < m; ++i) {
-    const double sc = atol + rtol * fmax(fabs(d->x[i]), fabs(d->xnew[i]));
+    const double sc = opt->atol + opt->rtol * fmax(fabs(d->x[i]), fabs(d->xnew[i]));
     const double e = d->err[i] / sc;
     s += e * e;
   }
+  for (size_t i = m; i < d->dim; ++i) /* an uncontrolled component that is not finite still fails the step */
+    if (!isfinite(d->err[i])) return INFINITY;
   s = sqrt(s / (double)m);
-  for (size_t i = m; i < d->dim; ++i) s += 0.0 * d->err[i]; /* a non-finite variation still fails the step */
   return isfinite(s) ? s : INFINITY;
 }
 
@@ -226,7 +227,7 @@ hm_status hm_dopri_dense(const hm_dopri d, double t, double *x_out) {
 /* Hairer's starting-step heuristic (Solving ODEs I, II.4) with one explicit Euler probe. */
 static hm_status dopri_initial_step(hm_dopri d, const hm_ode_system *sys, const hm_dopri_options *opt, double t,
                                     double h_max, double *h_out) {
-  const size_t n = opt->err_dim && opt->err_dim < d->dim ? opt->err_dim : d->dim; /* the controlled components */
+  const size_t n = hm_rk_err_dim(opt, d->dim); /* the controlled components */
   double d0 = 0.0, d1 = 0.0;
   for (size_t i = 0; i < n; ++i) {
     const double sc = opt->atol + opt->rtol * fabs(d->x[i]);
@@ -264,7 +265,7 @@ typedef struct {
 static hm_status dopri_attempt(void *ctx, double t, double h, double *err) {
   dopri_run *r = (dopri_run *)ctx;
   hm_status st = dopri_try(r->d, r->sys, t, h);
-  if (st == HM_OK) *err = dopri_error_norm(r->d, r->opt->rtol, r->opt->atol, r->opt->err_dim);
+  if (st == HM_OK) *err = dopri_error_norm(r->d, r->opt);
   return st;
 }
 

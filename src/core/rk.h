@@ -10,6 +10,11 @@
 hm_status hm_rk_check(const hm_ode_system *sys, size_t dim, const hm_dopri_options *opt, double t0, double t1,
                       const double *x);
 
+/* The number of leading components whose error is controlled (opt->err_dim, or all of dim). */
+static inline size_t hm_rk_err_dim(const hm_dopri_options *opt, size_t dim) {
+  return opt->err_dim && opt->err_dim < dim ? opt->err_dim : dim;
+}
+
 /* An explicit pair as the adaptive loop sees it. */
 typedef struct {
   /* One step of size h from t: HM_OK with the error norm in *err (+inf for a step that is not finite), or an
