@@ -100,8 +100,12 @@ void hm_monitor_settings(const hm_monitor m, hm_monitor_config *cfg);
 hm_table hm_monitor_table(const hm_monitor m);
 
 /* 1 with the conicity in use (of the latest update, not NO_DATA) in *conicity when refinement is on, the table has
- * fewer than max_curves curves and its expected interpolation error there exceeds a tolerance; else 0. */
+ * fewer than max_curves curves, its expected interpolation error there exceeds a tolerance, and no family failed
+ * within 1e-4 of it (hm_monitor_table_failed); else 0. */
 int hm_monitor_table_wanted(const hm_monitor m, double *conicity);
+/* The exact family at this conicity could not be computed: it is not wanted there again (the table's interpolation
+ * stays in use there) until another conicity fails. */
+void hm_monitor_table_failed(hm_monitor m, double conicity);
 /* Use table from the next update on. The monitor takes it over (also on failure, when it is destroyed). The table
  * it replaces goes to *replaced (the caller destroys it, e.g. on the thread that made the new one, off the
  * callbacks) or, with replaced NULL, is destroyed. HM_EDOMAIN (reason in why) for a table of another vehicle,

@@ -159,7 +159,6 @@ static int push_speeds_until(cli_csv *c, double t, double *next, int *have_next,
 typedef struct {
   hm_monitor mon;
   const hm_vehicle *veh;
-  double failed_conicity;  /* where an exact family could not be computed (not retried) */
   double every, v_const, next_out, t_written, t_last;
   unsigned long i;
   cli_csv *spd;
@@ -171,11 +170,11 @@ typedef struct {
  * monitor wants one (monitor.h). */
 static void refine_table(run_state *r) {
   double c;
-  if (!hm_monitor_table_wanted(r->mon, &c) || fabs(c - r->failed_conicity) <= 1e-4) return;
+  if (!hm_monitor_table_wanted(r->mon, &c)) return;
   hm_table t = NULL;
   if (hm_table_refine(hm_monitor_table(r->mon), r->veh, c, &t) != HM_OK ||
       hm_monitor_replace_table(r->mon, t, NULL, NULL, 0) != HM_OK)
-    r->failed_conicity = c;
+    hm_monitor_table_failed(r->mon, c);
 }
 
 /* One acceleration row through the monitor, a JSON line per output interval. */
@@ -233,7 +232,7 @@ int cmd_estimate(const cli_args *a) {
             n_head == 0 ? "no samples (only a header)" : "fewer than two samples with a finite time stamp");
     rc = 1;
   }
-  run_state run = {NULL, &veh, -1.0, every, v_const, NAN, -INFINITY, -INFINITY, 0, NULL, {0.0, 0.0}, 0};
+  run_state run = {NULL, &veh, every, v_const, NAN, -INFINITY, -INFINITY, 0, NULL, {0.0, 0.0}, 0};
   if (rc == 0 && speed_path) {
     rc = cli_csv_open(&spd, speed_path, 2, 1);
     spd_open = rc == 0;

@@ -33,6 +33,7 @@ struct hm_monitor_s {
   hm_window_verdict verdict;
   double committed_until;        /* end of the last window committed to the margin (or the stream's restart) */
   double conicity_in_use;        /* of the latest update that had data; NAN before */
+  double refine_failed_at;       /* the conicity whose exact family could not be computed; NAN if none */
 };
 
 void hm_monitor_config_default(hm_monitor_config *c) {
@@ -131,6 +132,7 @@ hm_status hm_monitor_create_parallel(const hm_monitor_config *cfg, const hm_vehi
   }
   m->modal_ok = 1;
   m->conicity_in_use = NAN;
+  m->refine_failed_at = NAN;
   m->restarts = hm_estimator_restarts(m->est, &m->rate_hz);
   restart_stream(m);
   *out = m;
@@ -294,8 +296,13 @@ int hm_monitor_table_wanted(const hm_monitor m, double *conicity) {
   if (!(m->conicity_in_use > lo && m->conicity_in_use < hi)) return 0; /* outside: clamped, nothing to add */
   if (hm_table_local_error(m->table, m->conicity_in_use, &e_kmh, &e_m) != HM_OK) return 0;
   if (e_kmh <= m->cfg.table.tolerance_kmh && e_m <= m->cfg.table.tolerance_m) return 0;
+  if (fabs(m->conicity_in_use - m->refine_failed_at) <= 1e-4) return 0; /* failed there: not retried */
   *conicity = m->conicity_in_use;
   return 1;
+}
+
+void hm_monitor_table_failed(hm_monitor m, double conicity) {
+  if (m) m->refine_failed_at = conicity;
 }
 
 hm_status hm_monitor_replace_table(hm_monitor m, hm_table table, hm_table *replaced, char *why, size_t len) {

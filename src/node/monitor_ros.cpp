@@ -157,15 +157,15 @@ void MonitorRos::refineTable() {
   } else if (failed) {
     last_refine_error_ = hm_status_str(st);
   }
-  if (failed) {  // not retried at that conicity: the table's interpolation stays in use there
+  if (failed) {  // not retried at that conicity (the core's policy): the table's interpolation stays in use there
     ++refinement_failures_;
-    failed_conicity_ = c;
+    hm_monitor_table_failed(monitor_, c);
     ROS_WARN_COND(!bench_table_churn_, "hunting_monitor: no exact cycle family at conicity %.4f: %s", c,
                   last_refine_error_.c_str());
   }
   double want = 0.0, lo = 0.0, hi = 0.0;
   if (refiner_->busy()) return;
-  if (hm_monitor_table_wanted(monitor_, &want) && std::fabs(want - failed_conicity_) > 1e-4) {
+  if (hm_monitor_table_wanted(monitor_, &want)) {
     refiner_->request(hm_monitor_table(monitor_), want);
   } else if (bench_table_churn_ && ros::WallTime::now().toSec() >= next_churn_ &&
              hm_table_size(hm_monitor_table(monitor_), &lo, &hi) < cfg_.table.max_curves) {

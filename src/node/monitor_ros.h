@@ -66,7 +66,7 @@ class MonitorRos {
   // the table's refinement (the core says where, the worker computes, the callbacks never wait)
   std::unique_ptr<TableRefiner> refiner_;
   unsigned long refinements_ = 0, refinement_failures_ = 0;
-  double last_refined_conicity_ = 0.0, last_refine_s_ = 0.0, failed_conicity_ = -1.0;
+  double last_refined_conicity_ = 0.0, last_refine_s_ = 0.0;
   std::string last_refine_error_;
   bool bench_table_churn_ = false;  // ~bench_table_churn: benchmarking only, a refinement every 0.5 s
   double churn_ = 0.0, next_churn_ = 0.0;

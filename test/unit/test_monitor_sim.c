@@ -172,6 +172,11 @@ static void table_refined_at_the_conicity_in_use(void) {
   HM_CHECK(r.last.assessment.level != HM_LEVEL_NO_DATA, "no data after 5 s");
   HM_CHECK(hm_monitor_table_wanted(r.mon, &c) == 1 && c == r.last.assessment.conicity, "refinement wanted at %g", c);
   HM_CHECK_DELTA(c, 0.1358, 1e-12, "the fallback conicity (the vehicle's lambda(0))");
+  double c2 = 0.0;
+  hm_monitor_table_failed(r.mon, c);
+  HM_CHECK(hm_monitor_table_wanted(r.mon, &c2) == 0, "wanted again where the family failed");
+  hm_monitor_table_failed(r.mon, c + 0.01);
+  HM_CHECK(hm_monitor_table_wanted(r.mon, &c2) == 1 && c2 == c, "not wanted after a failure elsewhere");
   const double before = r.last.assessment.boundaries.lowest_cycle_speed_kmh;
   hm_table refined = NULL;
   HM_CHECK(hm_table_refine(hm_monitor_table(r.mon), &vehicle, c, &refined) == HM_OK, "refine");
