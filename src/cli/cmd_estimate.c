@@ -15,7 +15,7 @@ const cli_option estimate_opts[] = {
     {"speed", "FILE", "speed CSV with header t_s,speed_kmh"},
     {"v", "KM/H", "constant speed instead of --speed"},
     {"monitor", "FILE", "estimator and alarm settings (default: built-in = config/monitor.yaml)"},
-    {"table", "FILE", "boundary table from 'hunting tables' (default: computed at start, about 0.3 s)"},
+    {"table", "FILE", "boundary table from 'hunting tables' (default: computed at start, 36 conicities in about 0.6 s)"},
     {"every", "SECONDS", "output interval in data time (default 0.1)"},
     CLI_VEHICLE_OPTIONS,
     {NULL, NULL, NULL}};
