@@ -21,7 +21,9 @@ namespace {
 double finite(double x) { return std::isfinite(x) ? x : 0.0; }
 }  // namespace
 
-MonitorRos::MonitorRos(ros::NodeHandle nh, ros::NodeHandle pnh) : nh_(nh), pnh_(pnh), updater_(nh, pnh) {
+// The diagnostics are named after the private namespace: the node's name, or the nodelet's (not its manager's).
+MonitorRos::MonitorRos(ros::NodeHandle nh, ros::NodeHandle pnh)
+    : nh_(nh), pnh_(pnh), updater_(nh, pnh, pnh.getNamespace()) {
   if (!loadParameters()) return;
   if (accel_type_ == "imu")
     accel_sub_ = nh_.subscribe("accel", 4000, &MonitorRos::onAccelImu, this, ros::TransportHints().tcpNoDelay());
@@ -42,6 +44,12 @@ MonitorRos::MonitorRos(ros::NodeHandle nh, ros::NodeHandle pnh) : nh_(nh), pnh_(
   updater_.add("inputs", this, &MonitorRos::diagnoseInputs);
   updater_.add("hunting level", this, &MonitorRos::diagnoseLevel);
   updater_.add("boundary table", this, &MonitorRos::diagnoseTable);
+  updater_.add("settings", this, &MonitorRos::diagnoseSettings);
+  if (allow_reconfigure_) {
+    reconfigure_.reset(new SettingsReconfigure(pnh_, monitor_));
+    ROS_WARN("hunting_monitor: ~allow_reconfigure: the alarm and criteria settings can be changed through "
+             "dynamic_reconfigure (%s/set_parameters)", pnh_.getNamespace().c_str());
+  }
   timer_ = nh_.createTimer(ros::Duration(1.0 / status_rate_hz_), &MonitorRos::onTimer, this);
   ok_ = true;
   ROS_INFO("hunting_monitor: ready (accel %s at %.0f Hz stamped by %s time, speed in %s, status at %.1f Hz, table %s)",
@@ -77,6 +85,7 @@ bool MonitorRos::loadParameters() {
   pnh_.param<std::string>("table_file", table_file_, "");
   pnh_.param("status_rate_hz", status_rate_hz_, 20.0);
   pnh_.param("bench_table_churn", bench_table_churn_, false);
+  pnh_.param("allow_reconfigure", allow_reconfigure_, false);
   pnh_.param("max_clock_offset_s", max_clock_offset_s_, 1.0);
   if (!(max_clock_offset_s_ > 0.0 && max_clock_offset_s_ <= 3600.0)) {
     ROS_FATAL("hunting_monitor: ~max_clock_offset_s must be in (0, 3600], got %g", max_clock_offset_s_);
@@ -459,6 +468,13 @@ void MonitorRos::diagnoseTable(diagnostic_updater::DiagnosticStatusWrapper& stat
     stat.add("last exact family took [ms]", 1e3 * last_refine_s_);
   }
   if (refinement_failures_ > 0) stat.add("last failure", last_refine_error_);
+}
+
+void MonitorRos::diagnoseSettings(diagnostic_updater::DiagnosticStatusWrapper& stat) {
+  if (reconfigure_)
+    reconfigure_->diagnose(stat);
+  else
+    stat.summary(diagnostic_msgs::DiagnosticStatus::OK, "settings as loaded (dynamic_reconfigure not allowed)");
 }
 
 }  // namespace hunting_monitor

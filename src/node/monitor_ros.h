@@ -12,6 +12,7 @@
 #include <memory>
 #include <string>
 
+#include "settings_reconfigure.h"
 #include "stability_chart.h"
 #include "table_refiner.h"
 
@@ -47,6 +48,7 @@ class MonitorRos {
   void diagnoseInputs(diagnostic_updater::DiagnosticStatusWrapper& stat);
   void diagnoseLevel(diagnostic_updater::DiagnosticStatusWrapper& stat);
   void diagnoseTable(diagnostic_updater::DiagnosticStatusWrapper& stat);
+  void diagnoseSettings(diagnostic_updater::DiagnosticStatusWrapper& stat);
 
   ros::NodeHandle nh_, pnh_;
   bool ok_ = false;
@@ -55,6 +57,7 @@ class MonitorRos {
   int axis_ = 1;                  // ~imu_axis resolved once: 0 x, 1 y, 2 z
   bool header_time_ = true;       // ~time_source: Imu header stamps (true) or receipt time
   double status_rate_hz_ = 20.0;
+  bool allow_reconfigure_ = false;  // ~allow_reconfigure: offer the alarm and criteria settings to dynamic_reconfigure
   hm_vehicle vehicle_{};
   hm_monitor_config cfg_{};
   // the core's monitor (estimator, identification, margin, alarm, table)
@@ -82,6 +85,7 @@ class MonitorRos {
   ros::Subscriber accel_sub_, speed_sub_;
   ros::Publisher status_pub_, alarm_pub_, marker_pub_, chart_pub_;
   std::unique_ptr<StabilityChart> chart_;
+  std::unique_ptr<SettingsReconfigure> reconfigure_;  // only with ~allow_reconfigure
   ros::Timer timer_;
   diagnostic_updater::Updater updater_;
   double accel_min_hz_ = 0.0, accel_max_hz_ = 0.0;

@@ -24,7 +24,7 @@ LEVELS = ["NO_DATA", "OK", "WATCH", "WARN", "ALARM"]
 
 
 class Replay(unittest.TestCase):
-    status, diagnostics, markers, chart = [], [], [], []
+    status, diagnostics, markers, chart, nodelet_status = [], [], [], [], []
     reference = []
 
     @classmethod
@@ -41,6 +41,7 @@ class Replay(unittest.TestCase):
         rospy.Subscriber("/diagnostics", DiagnosticArray, keep(cls.diagnostics), queue_size=100)
         rospy.Subscriber("hunting_markers", MarkerArray, keep(cls.markers), queue_size=100)
         rospy.Subscriber("hunting_chart", MarkerArray, keep(cls.chart), queue_size=1000)
+        rospy.Subscriber("/nodelet/hunting_status", HuntingStatus, keep(cls.nodelet_status), queue_size=1000)
         deadline = time.time() + 150.0
         while time.time() < deadline:
             with lock:
@@ -109,6 +110,34 @@ class Replay(unittest.TestCase):
         self.assertLessEqual(first_alarm.speed_kmh, 517.618 + 3.0)
         self.assertTrue(all(m.level == HuntingStatus.LEVEL_ALARM for m in seq if m.speed_kmh >= 520.0))
         self.assertTrue(all(b.level >= a.level for a, b in zip(seq, seq[1:])), "the level went down on the ramp")
+
+    def test_nodelet_gives_the_node_levels(self):
+        """hunting_monitor/MonitorNodelet in a nodelet manager, on the same bag at the same time: the same levels at
+        the same times (its status timer has its own phase: a change may show one status period, 0.05 s, apart) and
+        the same margins."""
+        node = self.data_statuses()
+        nodelet = [m for m in self.nodelet_status if T0 + 1.5 <= m.header.stamp.to_sec() <= T0 + DURATION - 0.1]
+        self.assertGreater(len(nodelet), 0.9 * len(node), "the nodelet published too few statuses")
+
+        def changes(seq):
+            return [(m.header.stamp.to_sec(), m.level) for a, m in zip(seq, seq[1:]) if m.level != a.level]
+        a, b = changes(node), changes(nodelet)
+        self.assertEqual([lv for _, lv in a], [lv for _, lv in b], "level sequences differ")
+        for (ta, _), (tb, _) in zip(a, b):
+            self.assertLessEqual(abs(ta - tb), 0.1 + 1e-6, (ta, tb))
+        # the nearest statuses (at most half a status period apart) give the same Hopf speed and the same margin
+        # plus speed (the speed itself may be one 10 Hz speed sample apart: 0.1 s x 6.4 km/h/s)
+        stamps = [m.header.stamp.to_sec() for m in nodelet]
+        pairs = 0
+        for m in node:
+            i = bisect.bisect_left(stamps, m.header.stamp.to_sec() - 0.03)
+            if i < len(nodelet) and abs(stamps[i] - m.header.stamp.to_sec()) <= 0.03 and m.boundaries_valid:
+                pairs += 1
+                self.assertAlmostEqual(nodelet[i].hopf_speed_kmh, m.hopf_speed_kmh, delta=0.05)
+                self.assertAlmostEqual(nodelet[i].speed_kmh, m.speed_kmh, delta=0.65)
+                self.assertAlmostEqual(nodelet[i].margin_to_hopf_kmh + nodelet[i].speed_kmh,
+                                       m.margin_to_hopf_kmh + m.speed_kmh, delta=0.5)
+        self.assertGreater(pairs, 0.5 * len(node))
 
     def test_margins_match_the_offline_reference(self):
         times = [r["t_s"] for r in self.reference]

@@ -1,12 +1,14 @@
 #!/usr/bin/python3
 """The node stays up and reports bad input (NaN, out-of-order stamps, silence) and exits with a clear message on
-bad parameters."""
+bad parameters; its settings change through dynamic_reconfigure only when allowed, validated by the core."""
 import math
 import subprocess
 import threading
 import time
 import unittest
 
+import dynamic_reconfigure.client
+import rosgraph
 import roslib.packages
 import rospy
 import rostest
@@ -22,8 +24,9 @@ class Robustness(unittest.TestCase):
     def setUpClass(cls):
         rospy.init_node("test_robustness")
         cls.lock = threading.Lock()
-        cls.status, cls.diag = [], []
+        cls.status, cls.diag, cls.rc_status = [], [], []
         rospy.Subscriber("hunting_status", HuntingStatus, cls.keep(cls.status), queue_size=1000)
+        rospy.Subscriber("/rc/hunting_status", HuntingStatus, cls.keep(cls.rc_status), queue_size=1000)
         rospy.Subscriber("/diagnostics", DiagnosticArray, cls.keep(cls.diag), queue_size=100)
         cls.accel = rospy.Publisher("accel", Imu, queue_size=1000)
         cls.speed = rospy.Publisher("speed", Float64, queue_size=10)
@@ -61,13 +64,14 @@ class Robustness(unittest.TestCase):
             self.assertEqual(m.reason_code, 4, m.reason)  # normal running: the bistable band is in the fields
             self.assertLess(m.margin_to_lowest_cycle_kmh, 0.0)
 
-    def latest(self, after):
+    def latest(self, after, store=None):
         with self.lock:
-            return [m for m in self.status if m.header.stamp.to_sec() > after]
+            return [m for m in (self.status if store is None else store) if m.header.stamp.to_sec() > after]
 
-    def diag_level(self, name, after):
+    def diag_level(self, name, after, node="/hunting_monitor"):
         with self.lock:
-            hits = [s for a in self.diag if a.header.stamp.to_sec() > after for s in a.status if name in s.name]
+            hits = [s for a in self.diag if a.header.stamp.to_sec() > after for s in a.status
+                    if s.name == f"{node[1:]}: {name}"]
         return hits[-1] if hits else None
 
     def test_1_good_data_then_nan_and_out_of_order(self):
@@ -156,6 +160,70 @@ class Robustness(unittest.TestCase):
             sub.unregister()
             proc.terminate()
             proc.wait(timeout=10)
+
+    def test_5_dynamic_reconfigure(self):
+        """Off by default (no service); allowed on /rc/hunting_monitor: a valid change is applied at once (the level
+        follows), logged in diagnostics with its values; invalid ones are refused with the running settings kept."""
+        services = [s for s, _ in rosgraph.Master("/test_robustness").getSystemState()[2]]
+        self.assertNotIn("/hunting_monitor/set_parameters", services)
+        self.assertIn("/rc/hunting_monitor/set_parameters", services)
+        t = rospy.Time.now().to_sec()
+        self.stream(3.5)  # 400 km/h: OK (diagnostics come once a second)
+        d = self.diag_level("settings", t)
+        self.assertEqual((d.level, d.message), (0, "settings as loaded (dynamic_reconfigure not allowed)"))
+        d = self.diag_level("settings", t, "/rc/hunting_monitor")
+        self.assertEqual((d.level, d.message), (0, "settings as loaded (dynamic_reconfigure allowed)"))
+        before = self.latest(t + 2.0, self.rc_status)[-1]
+        self.assertIn(before.level, (HuntingStatus.LEVEL_OK, HuntingStatus.LEVEL_WATCH), before.reason)
+        margin = before.margin_to_hopf_kmh  # about 117 km/h below the Hopf speed
+        self.assertGreater(margin, 50.0)
+
+        client = dynamic_reconfigure.client.Client("/rc/hunting_monitor", timeout=10)
+        loaded = client.get_configuration(timeout=10)
+        self.assertEqual((loaded["warn_speed_margin_kmh"], loaded["watch_speed_margin_kmh"]), (10.0, 30.0))  # yaml
+        warn, watch = round(margin) + 20.0, round(margin) + 40.0  # the running speed now inside the WARN margin
+        t = rospy.Time.now().to_sec()
+        done = [None]
+        feeder = threading.Thread(target=lambda: self.stream(3.5))
+        feeder.start()
+        time.sleep(0.5)
+        done[0] = client.update_configuration({"warn_speed_margin_kmh": warn, "watch_speed_margin_kmh": watch})
+        changed_at = rospy.Time.now().to_sec()
+        feeder.join()
+        got = done[0]
+        self.assertEqual((got["warn_speed_margin_kmh"], got["watch_speed_margin_kmh"]), (warn, watch))
+        self.assertTrue(got["result"].startswith("applied: "), got["result"])
+        after = self.latest(changed_at + 0.2, self.rc_status)
+        self.assertTrue(after and all(m.level == HuntingStatus.LEVEL_WARN and m.reason_code == 5 for m in after),
+                        [(m.level, m.reason) for m in after])  # near the Hopf speed, by the new margin
+        self.assertTrue(all(m.level != HuntingStatus.LEVEL_WARN for m in self.latest(changed_at + 0.2)))  # not /hm
+        d = self.diag_level("settings", changed_at, "/rc/hunting_monitor")
+        self.assertEqual((d.level, d.message), (1, "settings changed at runtime"))
+        values = {kv.key: kv.value for kv in d.values}
+        self.assertEqual(values["alarm.warn_speed_margin_kmh"], f"10 -> {warn:g}")
+        self.assertEqual(values["alarm.watch_speed_margin_kmh"], f"30 -> {watch:g}")
+
+        # refused by the core's validator: the WATCH margin below the WARN margin, a negative hysteresis, a zero and
+        # a negative peaks count, NaN; each answer carries the running settings and the reason
+        for change, field in [({"watch_speed_margin_kmh": warn - 5.0}, "alarm.watch_speed_margin_kmh"),
+                              ({"hysteresis_kmh": -1.0}, "alarm.hysteresis_kmh"),
+                              ({"peaks_count": 0}, "estimator.peaks_count"),
+                              ({"peaks_count": -3}, "estimator.peaks_count"),
+                              ({"rms_limit_mps2": float("nan")}, "estimator.rms_limit_mps2")]:
+            got = client.update_configuration(change)
+            self.assertTrue(got["result"].startswith("refused: "), (change, got["result"]))
+            self.assertIn(field, got["result"])
+            self.assertEqual((got["warn_speed_margin_kmh"], got["watch_speed_margin_kmh"], got["hysteresis_kmh"],
+                              got["peaks_count"], got["rms_limit_mps2"]), (warn, watch, 3.0, 6, 12.0), change)
+        t = rospy.Time.now().to_sec()
+        self.stream(2.5)
+        self.assertTrue(all(m.level == HuntingStatus.LEVEL_WARN for m in self.latest(t + 0.2, self.rc_status)))
+        d = self.diag_level("settings", t, "/rc/hunting_monitor")
+        values = {kv.key: kv.value for kv in d.values}
+        self.assertEqual((d.level, values["changes refused"], values["changes applied"]), (1, "5", "1"))
+        self.assertIn("estimator.rms_limit_mps2", values["last refused"])  # the last one: NaN
+        got = client.update_configuration({"warn_speed_margin_kmh": 10.0, "watch_speed_margin_kmh": 30.0})
+        self.assertEqual(got["result"], "applied: settings as loaded")
 
     def run_bad_node(self, name, vehicle_changes, extra):
         with open(rospy.get_param("~vehicle_config")) as f:
