@@ -363,7 +363,7 @@ void MonitorRos::publishMarkers(const hm_monitor_status& st, const ros::Time& no
   visualization_msgs::Marker text = lamp;
   text.id = 1;
   text.type = visualization_msgs::Marker::TEXT_VIEW_FACING;
-  text.pose.position.z = 1.6;
+  text.pose.position.z = -1.3;  // below the lamp: the stability chart is to its right (x from 1.5 m)
   text.scale.x = text.scale.y = 0.0;
   text.scale.z = 0.16;
   text.color.r = text.color.g = text.color.b = 1.0;

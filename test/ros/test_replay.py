@@ -139,6 +139,38 @@ class Replay(unittest.TestCase):
                                        m.margin_to_hopf_kmh + m.speed_kmh, delta=0.5)
         self.assertGreater(pairs, 0.5 * len(node))
 
+    def test_rqt_perspective_plots_published_fields(self):
+        """config/hunting.perspective read as qt_gui reads it (JSON, each value eval'ed from its repr): the running
+        plugins are the groups it configures, and every rqt_plot topic is a numeric field of the statuses the node
+        published here (rqt itself is not in Debian's archive: this checks the file, not rqt)."""
+        path = os.path.join(os.path.dirname(rospy.get_param("~table")), "hunting.perspective")
+        with open(path) as f:
+            data = json.load(f)
+
+        def value(v):
+            self.assertEqual(v["type"], "repr")
+            return eval(v["repr"], {})  # qt_gui's PerspectiveManager._import_value
+        manager = data["groups"]["pluginmanager"]
+        running = value(manager["keys"]["running-plugins"])
+        self.assertEqual(set(running), {"rqt_plot/Plot", "rqt_robot_monitor/RobotMonitor"})
+        self.assertEqual(set(manager["groups"]), {"plugin__" + p.replace("/", "__") + f"__{n}"
+                                                  for p, serials in running.items() for n in serials})
+        last = self.data_statuses()[-1]
+        fields = set()
+        for n in running["rqt_plot/Plot"]:
+            keys = manager["groups"][f"plugin__rqt_plot__Plot__{n}"]["groups"]["plugin"]["keys"]
+            topics = value(keys["topics"])
+            self.assertTrue(topics)
+            for t in topics:
+                self.assertTrue(t.startswith("/hunting_status/"), t)
+                field = t[len("/hunting_status/"):]
+                self.assertIsInstance(getattr(last, field), float, t)
+                fields.add(field)
+            lo, hi = value(keys["y_limits"])
+            self.assertLess(lo, hi)
+        # what the issue asks to see: the margins, the amplitude, the frequency and the damping
+        self.assertTrue({"margin_to_hopf_kmh", "amplitude_displacement_m", "frequency_hz", "damping_ratio"} <= fields)
+
     def test_margins_match_the_offline_reference(self):
         times = [r["t_s"] for r in self.reference]
         agree_level = agree_margin = n = 0
