@@ -58,6 +58,12 @@ MonitorRos::MonitorRos(ros::NodeHandle nh, ros::NodeHandle pnh)
 }
 
 MonitorRos::~MonitorRos() {
+  // No callback may touch the monitor once it is freed: as a nodelet this object is destroyed while the manager
+  // runs on; shutting down waits for a callback in progress.
+  timer_.stop();
+  accel_sub_.shutdown();
+  speed_sub_.shutdown();
+  reconfigure_.reset();
   refiner_.reset();  // joins the worker, which may be reading the monitor's table
   hm_monitor_destroy(monitor_);
 }
