@@ -116,7 +116,7 @@ void StabilityChart::drawFamily(visualization_msgs::MarkerArray* arr, double con
     if (!pts[k].fold) continue;
     marks.points.push_back(at(pts[k].speed_kmh, pts[k].amp_m));
     geometry_msgs::Point p = marks.points.back();
-    p.x += 0.45;
+    p.x += 0.95;  // the label (about 1.7 m wide, centred) to the right of its mark
     std::snprintf(text, sizeof text, "LPC %.1f km/h, %.1f mm", pts[k].speed_kmh, 1e3 * pts[k].amp_m);
     arr->markers.push_back(label(frame_id_, now, "chart_labels", fold_id++, p, text, 0.12));
   }
@@ -157,11 +157,18 @@ visualization_msgs::MarkerArray StabilityChart::update(const hm_monitor_status& 
   point.scale.x = point.scale.y = point.scale.z = 0.2;
   point.pose.position = at(e.speed_kmh, amp);
   arr.markers.push_back(point);
-  char text[160];
-  std::snprintf(text, sizeof text, "%s  V %.1f km/h  margin to Hopf %+.1f km/h, to lowest cycle %+.1f km/h",
-                hm_level_name(s.level), e.speed_kmh, s.margin_hopf_kmh, s.margin_lowest_cycle_kmh);
+  // In words, not signs: rviz may drop a minus sign of small text at a distance (seen in the screenshots).
+  char text[200];
+  const double mh = s.margin_hopf_kmh, ml = s.margin_lowest_cycle_kmh;
+  char lowest[96];
+  if (ml >= 0.0)
+    std::snprintf(lowest, sizeof lowest, "%.1f km/h below the lowest cycle speed", ml);
+  else
+    std::snprintf(lowest, sizeof lowest, "bistable band (%.1f km/h above the lowest cycle speed)", -ml);
+  std::snprintf(text, sizeof text, "%s  V %.1f km/h  %.1f km/h %s the Hopf speed\n%s", hm_level_name(s.level),
+                e.speed_kmh, std::fabs(mh), mh >= 0.0 ? "below" : "ABOVE", lowest);
   geometry_msgs::Point tp = at(kSpeedMax / 2, kAmpMax);
-  tp.z += 0.75;
+  tp.z += 0.95;  // two lines above the family's title
   arr.markers.push_back(label(frame_id_, now, "chart_now", 2, tp, text, 0.18));
   return arr;
 }
