@@ -377,10 +377,11 @@ void MonitorRos::publishMarkers(const hm_monitor_status& st, const ros::Time& no
   if (st.mode.valid) std::snprintf(decay, sizeof decay, "%.2f 1/s", st.mode.decay_rate_1_s);
   if (s.boundaries_valid)
     std::snprintf(buf, sizeof buf,
-                  "%s: %s\nV %.1f km/h  Hopf %.1f [%.1f, %.1f] (margin %.1f)  lowest cycle %.1f\n"
+                  "%s: %s\nV %.1f km/h  Hopf %.1f [%.1f, %.1f] (%.1f km/h %s)  lowest cycle %.1f\n"
                   "amplitude %.2f mm at %.1f Hz  unstable cycle %.2f mm\nconicity %.3f (%s)  decay %s",
                   hm_level_name(s.level), hm_reason_text(s.reason), e.speed_kmh, s.boundaries.hopf_speed_kmh,
-                  s.hopf_low_kmh, s.hopf_high_kmh, s.margin_hopf_kmh, s.boundaries.lowest_cycle_speed_kmh,
+                  s.hopf_low_kmh, s.hopf_high_kmh, std::fabs(s.margin_hopf_kmh),  // words: rviz may drop a minus
+                  s.margin_hopf_kmh >= 0.0 ? "below" : "ABOVE", s.boundaries.lowest_cycle_speed_kmh,
                   1e3 * e.amplitude_displacement_m, e.frequency_hz, 1e3 * s.edge_used_m, s.conicity,
                   s.conicity_from_estimate ? "identified" : "configured", decay);
   else
