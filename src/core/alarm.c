@@ -58,27 +58,29 @@ void hm_alarm_config_default(hm_alarm_config *c) {
 }
 
 hm_status hm_alarm_config_validate(const hm_alarm_config *c, char *why, size_t len) {
-  const char *field = NULL;
+  const char *field = NULL, *rule = NULL;
   double got = 0.0;
   if (!c) return HM_EINVAL;
   if (!(c->warn_amplitude_fraction > 0.0 && c->warn_amplitude_fraction < 1.0))
-    field = "warn_amplitude_fraction", got = c->warn_amplitude_fraction;
+    field = "warn_amplitude_fraction", rule = "must be in (0, 1)", got = c->warn_amplitude_fraction;
   else if (!(c->warn_speed_margin_kmh >= 0.0 && c->warn_speed_margin_kmh <= 500.0))
-    field = "warn_speed_margin_kmh", got = c->warn_speed_margin_kmh;
+    field = "warn_speed_margin_kmh", rule = "must be in [0, 500]", got = c->warn_speed_margin_kmh;
   else if (!(c->watch_speed_margin_kmh >= c->warn_speed_margin_kmh && c->watch_speed_margin_kmh <= 500.0))
-    field = "watch_speed_margin_kmh", got = c->watch_speed_margin_kmh;
+    field = "watch_speed_margin_kmh", rule = "must be at least warn_speed_margin_kmh and at most 500",
+    got = c->watch_speed_margin_kmh;
   else if (!(c->hysteresis_kmh >= 0.0 && c->hysteresis_kmh <= 100.0))
-    field = "hysteresis_kmh", got = c->hysteresis_kmh;
+    field = "hysteresis_kmh", rule = "must be in [0, 100]", got = c->hysteresis_kmh;
   else if (!(c->hysteresis_amplitude_fraction >= 0.0 && c->hysteresis_amplitude_fraction < c->warn_amplitude_fraction))
-    field = "hysteresis_amplitude_fraction", got = c->hysteresis_amplitude_fraction;
+    field = "hysteresis_amplitude_fraction", rule = "must be at least 0 and below warn_amplitude_fraction",
+    got = c->hysteresis_amplitude_fraction;
   else if (!(c->min_hold_s >= 0.0 && c->min_hold_s <= 3600.0))
-    field = "min_hold_s", got = c->min_hold_s;
+    field = "min_hold_s", rule = "must be in [0, 3600]", got = c->min_hold_s;
   else if (!(c->conicity_max_se > 0.0 && c->conicity_max_se <= 1.0))
-    field = "conicity_max_se", got = c->conicity_max_se;
+    field = "conicity_max_se", rule = "must be in (0, 1]", got = c->conicity_max_se;
   else if (!(c->conicity_fallback >= 0.0 && c->conicity_fallback <= 10.0))
-    field = "conicity_fallback", got = c->conicity_fallback;
+    field = "conicity_fallback", rule = "must be in [0, 10]", got = c->conicity_fallback;
   if (!field) return HM_OK;
-  if (why && len) snprintf(why, len, "%s: out of range (got %g)", field, got);
+  if (why && len) snprintf(why, len, "%s: out of range: %s (got %g)", field, rule, got);
   return HM_EDOMAIN;
 }
 

@@ -148,6 +148,13 @@ static void bad_configuration_and_input(void) {
   hm_alarm_config_default(&c);
   c.min_hold_s = NAN;
   HM_CHECK(hm_alarm_config_validate(&c, why, sizeof why) == HM_EDOMAIN && strstr(why, "min_hold_s"), "%s", why);
+  /* a cross-field rule is stated, not only the value (a refused runtime change tells the operator why) */
+  hm_alarm_config_default(&c);
+  c.watch_speed_margin_kmh = c.warn_speed_margin_kmh - 5.0;
+  HM_CHECK(hm_alarm_config_validate(&c, why, sizeof why) == HM_EDOMAIN &&
+               strstr(why, "watch_speed_margin_kmh: out of range: must be at least warn_speed_margin_kmh") &&
+               strstr(why, "(got 5)"),
+           "%s", why);
   hm_alarm a = make();
   hm_assessment s;
   const hm_estimate e = estimate(300.0, 0.0);
