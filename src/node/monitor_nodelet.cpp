@@ -5,6 +5,7 @@
 #include <pluginlib/class_list_macros.hpp>
 
 #include <memory>
+#include <stdexcept>
 
 #include "monitor_ros.h"
 
@@ -17,9 +18,10 @@ class MonitorNodelet : public nodelet::Nodelet {
     // as in the node, so MonitorRos needs no lock of its own.
     monitor_.reset(new MonitorRos(getNodeHandle(), getPrivateNodeHandle()));
     if (!monitor_->ok()) {
-      // a bad parameter was logged (ROS_FATAL) by MonitorRos; a nodelet cannot exit its manager, so it stays inert
-      NODELET_FATAL("hunting_monitor: not monitoring: see the error above");
+      // A bad parameter was logged (ROS_FATAL) by MonitorRos. As the node exits with status 1, the load fails: the
+      // manager drops the nodelet and runs on, `nodelet load` exits with an error (a required one ends the launch).
       monitor_.reset();
+      throw std::runtime_error("hunting_monitor: bad parameters (see the error above): not loaded");
     }
   }
   std::unique_ptr<MonitorRos> monitor_;

@@ -15,6 +15,7 @@ import rostest
 import yaml
 from diagnostic_msgs.msg import DiagnosticArray
 from hunting_monitor.msg import HuntingStatus
+from nodelet.srv import NodeletList
 from sensor_msgs.msg import Imu
 from std_msgs.msg import Float64
 
@@ -251,6 +252,29 @@ class Robustness(unittest.TestCase):
             code, out = self.run_bad_node(name, changes, extra)
             self.assertNotEqual(code, 0, f"{name} exited 0")
             self.assertIn(message, out, f"{name}: {out}")
+
+    def test_3b_bad_parameters_fail_the_nodelet_load(self):
+        """As a nodelet, a bad parameter fails the load (the manager runs on, without it), as the node exits 1."""
+        with open(rospy.get_param("~vehicle_config")) as f:
+            params = yaml.safe_load(f)
+        for section, value in params.items():
+            rospy.set_param(f"/bad_nodelet/{section}", value)
+        rospy.set_param("/bad_nodelet/table_file", rospy.get_param("~table"))
+        nodelet = roslib.packages.find_node("nodelet", "nodelet")[0]
+        manager = subprocess.Popen([nodelet, "manager", "__name:=bad_manager"], stdout=subprocess.DEVNULL,
+                                   stderr=subprocess.DEVNULL)
+        try:
+            p = subprocess.run([nodelet, "load", "hunting_monitor/MonitorNodelet", "/bad_manager",
+                                "__name:=bad_nodelet", "_status_rate_hz:=-1"], capture_output=True, text=True,
+                               timeout=30)
+            self.assertNotEqual(p.returncode, 0, p.stdout + p.stderr)
+            self.assertIn("Failed to load nodelet", p.stdout + p.stderr)
+            self.assertIsNone(manager.poll(), "the manager died")
+            loaded = rospy.ServiceProxy("/bad_manager/list", NodeletList)()
+            self.assertEqual(list(loaded.nodelets), [])
+        finally:
+            manager.terminate()
+            manager.wait(timeout=10)
 
 
 if __name__ == "__main__":
