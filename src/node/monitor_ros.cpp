@@ -348,9 +348,7 @@ void MonitorRos::onTimer(const ros::TimerEvent&) {
 void MonitorRos::publishMarkers(const hm_monitor_status& st, const ros::Time& now) {
   const hm_estimate& e = st.estimate;
   const hm_assessment& s = st.assessment;
-  static const float colours[5][3] = {{0.5f, 0.5f, 0.5f}, {0.1f, 0.8f, 0.1f}, {0.9f, 0.9f, 0.1f},
-                                      {1.0f, 0.55f, 0.0f}, {0.9f, 0.1f, 0.1f}};
-  const float* c = colours[static_cast<int>(s.level)];
+  const float* c = levelColour(s.level);
   visualization_msgs::MarkerArray arr;
   visualization_msgs::Marker lamp;
   lamp.header.stamp = now;
@@ -377,11 +375,11 @@ void MonitorRos::publishMarkers(const hm_monitor_status& st, const ros::Time& no
   if (st.mode.valid) std::snprintf(decay, sizeof decay, "%.2f 1/s", st.mode.decay_rate_1_s);
   if (s.boundaries_valid)
     std::snprintf(buf, sizeof buf,
-                  "%s: %s\nV %.1f km/h  Hopf %.1f [%.1f, %.1f] (%.1f km/h %s)  lowest cycle %.1f\n"
+                  "%s: %s\nV %.1f km/h  Hopf %.1f [%.1f, %.1f] (%s)  lowest cycle %.1f\n"
                   "amplitude %.2f mm at %.1f Hz  unstable cycle %.2f mm\nconicity %.3f (%s)  decay %s",
                   hm_level_name(s.level), hm_reason_text(s.reason), e.speed_kmh, s.boundaries.hopf_speed_kmh,
-                  s.hopf_low_kmh, s.hopf_high_kmh, std::fabs(s.margin_hopf_kmh),  // words: rviz may drop a minus
-                  s.margin_hopf_kmh >= 0.0 ? "below" : "ABOVE", s.boundaries.lowest_cycle_speed_kmh,
+                  s.hopf_low_kmh, s.hopf_high_kmh, hopfMarginWords(s.margin_hopf_kmh).c_str(),
+                  s.boundaries.lowest_cycle_speed_kmh,
                   1e3 * e.amplitude_displacement_m, e.frequency_hz, 1e3 * s.edge_used_m, s.conicity,
                   s.conicity_from_estimate ? "identified" : "configured", decay);
   else

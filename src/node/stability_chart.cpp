@@ -47,6 +47,19 @@ visualization_msgs::Marker label(const std::string& frame, const ros::Time& now,
 
 }  // namespace
 
+const float* levelColour(hm_level level) {
+  static const float colours[5][3] = {{0.5f, 0.5f, 0.5f}, {0.1f, 0.8f, 0.1f}, {0.9f, 0.9f, 0.1f},
+                                      {1.0f, 0.55f, 0.0f}, {0.9f, 0.1f, 0.1f}};
+  const int i = static_cast<int>(level);
+  return colours[i >= 0 && i < 5 ? i : 0];
+}
+
+std::string hopfMarginWords(double margin_kmh) {
+  char text[48];
+  std::snprintf(text, sizeof text, "%.1f km/h %s", std::fabs(margin_kmh), margin_kmh >= 0.0 ? "below" : "ABOVE");
+  return text;
+}
+
 void StabilityChart::drawFamily(visualization_msgs::MarkerArray* arr, double conicity, hm_table table,
                                 const ros::Time& now) {
   visualization_msgs::Marker clear;
@@ -141,9 +154,7 @@ visualization_msgs::MarkerArray StabilityChart::update(const hm_monitor_status& 
     drawn_at_ = now.toSec();
   }
   // the operating point in the level's colour, the last 30 s behind it, the margins
-  static const float colours[5][3] = {{0.5f, 0.5f, 0.5f}, {0.1f, 0.8f, 0.1f}, {0.9f, 0.9f, 0.1f},
-                                      {1.0f, 0.55f, 0.0f}, {0.9f, 0.1f, 0.1f}};
-  const float* c = colours[static_cast<int>(s.level)];
+  const float* c = levelColour(s.level);
   const double t = now.toSec(), amp = e.oscillation_valid ? e.amplitude_displacement_m : 0.0;
   trail_.push_back({t, e.speed_kmh, amp});
   while (!trail_.empty() && (trail_.front().t < t - 30.0 || trail_.front().t > t)) trail_.pop_front();
@@ -157,16 +168,16 @@ visualization_msgs::MarkerArray StabilityChart::update(const hm_monitor_status& 
   point.scale.x = point.scale.y = point.scale.z = 0.2;
   point.pose.position = at(e.speed_kmh, amp);
   arr.markers.push_back(point);
-  // In words, not signs: rviz may drop a minus sign of small text at a distance (seen in the screenshots).
+  // in words, not signs (hopfMarginWords)
   char text[200];
-  const double mh = s.margin_hopf_kmh, ml = s.margin_lowest_cycle_kmh;
+  const double ml = s.margin_lowest_cycle_kmh;
   char lowest[96];
   if (ml >= 0.0)
     std::snprintf(lowest, sizeof lowest, "%.1f km/h below the lowest cycle speed", ml);
   else
     std::snprintf(lowest, sizeof lowest, "bistable band (%.1f km/h above the lowest cycle speed)", -ml);
-  std::snprintf(text, sizeof text, "%s  V %.1f km/h  %.1f km/h %s the Hopf speed\n%s", hm_level_name(s.level),
-                e.speed_kmh, std::fabs(mh), mh >= 0.0 ? "below" : "ABOVE", lowest);
+  std::snprintf(text, sizeof text, "%s  V %.1f km/h  %s the Hopf speed\n%s", hm_level_name(s.level), e.speed_kmh,
+                hopfMarginWords(s.margin_hopf_kmh).c_str(), lowest);
   geometry_msgs::Point tp = at(kSpeedMax / 2, kAmpMax);
   tp.z += 0.95;  // two lines above the family's title
   arr.markers.push_back(label(frame_id_, now, "chart_now", 2, tp, text, 0.18));

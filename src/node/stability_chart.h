@@ -18,6 +18,13 @@ extern "C" {
 
 namespace hunting_monitor {
 
+// The level's colour (r, g, b): NO_DATA grey, OK green, WATCH yellow, WARN orange, ALARM red; the lamp's and the
+// operating point's.
+const float* levelColour(hm_level level);
+// The margin to the Hopf speed in words, "6.6 km/h below" or "4.4 km/h ABOVE": rviz may drop the minus sign of small
+// text seen from a distance (it did in the screenshots), so neither the lamp nor the chart relies on a sign.
+std::string hopfMarginWords(double margin_kmh);
+
 class StabilityChart {
  public:
   static constexpr double kX0 = 1.5;       // m: where 0 km/h is drawn
