@@ -62,7 +62,7 @@ SettingsReconfigure::SettingsReconfigure(ros::NodeHandle pnh, hm_monitor monitor
 }
 
 void SettingsReconfigure::onReconfigure(MonitorConfig& config, uint32_t) {
-  const std::vector<std::string> before = changes();
+  const auto before = changes();
   hm_monitor_config running;
   hm_monitor_settings(monitor_, &running);
   hm_monitor_config want = running;
@@ -86,42 +86,40 @@ void SettingsReconfigure::onReconfigure(MonitorConfig& config, uint32_t) {
   }
   hm_monitor_config now;
   hm_monitor_settings(monitor_, &now);
-  const std::vector<std::string> after = changes();
+  const auto after = changes();
   std::string list;
-  for (const std::string& c : after) list += (list.empty() ? "" : ", ") + c;
+  for (const auto& c : after) list += (list.empty() ? "" : ", ") + c.first + ": " + c.second;
   if (after != before) {
     ++applied_;
-    ROS_WARN("hunting_monitor: settings changed at runtime (%s)", list.empty() ? "back to the loaded ones" : list.c_str());
+    ROS_WARN("hunting_monitor: settings changed at runtime (%s)",
+             list.empty() ? "back to the loaded ones" : list.c_str());
   }
   config = toReconfigure(now, list.empty() ? "applied: settings as loaded" : "applied: " + list);
 }
 
-std::vector<std::string> SettingsReconfigure::changes() const {
+std::vector<std::pair<std::string, std::string>> SettingsReconfigure::changes() const {
   hm_monitor_config now, loaded = loaded_;
   hm_monitor_settings(monitor_, &now);
-  std::vector<std::string> out;
+  std::vector<std::pair<std::string, std::string>> out;
   for (const Field& f : kFields)
     if (*f.core(&now) != *f.core(&loaded))
-      out.push_back(std::string(f.name) + ": " + fmt(*f.core(&loaded)) + " -> " + fmt(*f.core(&now)));
+      out.emplace_back(f.name, fmt(*f.core(&loaded)) + " -> " + fmt(*f.core(&now)));
   if (now.alarm.use_conicity_estimate != loaded.alarm.use_conicity_estimate)
-    out.push_back(std::string("alarm.use_conicity_estimate: ") + (loaded.alarm.use_conicity_estimate ? "true" : "false") +
-                  " -> " + (now.alarm.use_conicity_estimate ? "true" : "false"));
+    out.emplace_back("alarm.use_conicity_estimate", std::string(loaded.alarm.use_conicity_estimate ? "true" : "false") +
+                                                        " -> " + (now.alarm.use_conicity_estimate ? "true" : "false"));
   if (now.estimator.peaks_count != loaded.estimator.peaks_count)
-    out.push_back("estimator.peaks_count: " + std::to_string(loaded.estimator.peaks_count) + " -> " +
-                  std::to_string(now.estimator.peaks_count));
+    out.emplace_back("estimator.peaks_count", std::to_string(loaded.estimator.peaks_count) + " -> " +
+                                                  std::to_string(now.estimator.peaks_count));
   return out;
 }
 
 void SettingsReconfigure::diagnose(diagnostic_updater::DiagnosticStatusWrapper& stat) const {
-  const std::vector<std::string> c = changes();
+  const auto c = changes();
   if (c.empty())
     stat.summary(diagnostic_msgs::DiagnosticStatus::OK, "settings as loaded (dynamic_reconfigure allowed)");
   else
     stat.summary(diagnostic_msgs::DiagnosticStatus::WARN, "settings changed at runtime");
-  for (const std::string& s : c) {
-    const size_t colon = s.find(": ");
-    stat.add(s.substr(0, colon), s.substr(colon + 2));
-  }
+  for (const auto& change : c) stat.add(change.first, change.second);
   stat.add("changes applied", applied_);
   stat.add("changes refused", refused_);
   if (refused_ > 0) stat.add("last refused", last_refused_);

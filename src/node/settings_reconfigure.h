@@ -13,6 +13,7 @@
 
 #include <memory>
 #include <string>
+#include <utility>
 #include <vector>
 
 extern "C" {
@@ -27,8 +28,8 @@ class SettingsReconfigure {
   // touched from the callbacks of pnh's queue, the queue of every other callback of the monitor.
   SettingsReconfigure(ros::NodeHandle pnh, hm_monitor monitor);
   void diagnose(diagnostic_updater::DiagnosticStatusWrapper& stat) const;
-  // The running settings that differ from those loaded at start, as "section.field: loaded -> now".
-  std::vector<std::string> changes() const;
+  // The running settings that differ from those loaded at start: ("section.field", "loaded -> now").
+  std::vector<std::pair<std::string, std::string>> changes() const;
 
  private:
   void onReconfigure(MonitorConfig& config, uint32_t level);

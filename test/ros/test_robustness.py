@@ -188,15 +188,12 @@ class Robustness(unittest.TestCase):
         loaded = client.get_configuration(timeout=10)
         self.assertEqual((loaded["warn_speed_margin_kmh"], loaded["watch_speed_margin_kmh"]), (10.0, 30.0))  # yaml
         warn, watch = round(margin) + 20.0, round(margin) + 40.0  # the running speed now inside the WARN margin
-        t = rospy.Time.now().to_sec()
-        done = [None]
         feeder = threading.Thread(target=lambda: self.stream(3.5))
         feeder.start()
         time.sleep(0.5)
-        done[0] = client.update_configuration({"warn_speed_margin_kmh": warn, "watch_speed_margin_kmh": watch})
+        got = client.update_configuration({"warn_speed_margin_kmh": warn, "watch_speed_margin_kmh": watch})
         changed_at = rospy.Time.now().to_sec()
         feeder.join()
-        got = done[0]
         self.assertEqual((got["warn_speed_margin_kmh"], got["watch_speed_margin_kmh"]), (warn, watch))
         self.assertTrue(got["result"].startswith("applied: "), got["result"])
         after = self.latest(changed_at + 0.2, self.rc_status)
