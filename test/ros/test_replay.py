@@ -58,6 +58,17 @@ class Replay(unittest.TestCase):
     def data_statuses(self):
         return [m for m in self.status if T0 + 1.5 <= m.header.stamp.to_sec() <= T0 + DURATION - 0.1]
 
+    def matched(self, rows, t0):
+        """(status, row) for each data status with an offline output row (`hunting estimate`, times + t0 in bag
+        time) within 0.05 s: the nearest."""
+        times = [r["t_s"] for r in rows]
+        for m in self.data_statuses():
+            t = m.header.stamp.to_sec() - t0
+            i = bisect.bisect_left(times, t)
+            r = min((rows[j] for j in (i - 1, i) if 0 <= j < len(times)), key=lambda c: abs(c["t_s"] - t))
+            if abs(r["t_s"] - t) <= 0.05:
+                yield m, r
+
     def test_bag_to_csv_for_offline_analysis(self):
         """scripts/bag_to_csv gives back the samples the bag was made from (scripts/make_test_bag's CSVs, at bag time
         T0 + t), and `hunting estimate` on its CSVs agrees with the node's levels as on the originals."""
@@ -77,15 +88,10 @@ class Replay(unittest.TestCase):
                                   d + "/speed.csv", "--table", rospy.get_param("~table"), "--every", "0.05"],
                                  capture_output=True, text=True, check=True).stdout
         again = [json.loads(line) for line in out.splitlines() if line.strip()]
-        times = [r["t_s"] for r in again]
         n = agree = 0
-        for m in self.data_statuses():
-            t = m.header.stamp.to_sec()  # the converted CSVs are in bag time
-            i = bisect.bisect_left(times, t)
-            r = min((again[j] for j in (i - 1, i) if 0 <= j < len(times)), key=lambda c: abs(c["t_s"] - t))
-            if abs(r["t_s"] - t) <= 0.05:
-                n += 1
-                agree += LEVELS[m.level] == r["level"]
+        for m, r in self.matched(again, 0.0):  # the converted CSVs are in bag time
+            n += 1
+            agree += LEVELS[m.level] == r["level"]
         self.assertGreater(n, 400, "too few matched status messages")
         self.assertGreaterEqual(agree / n, 0.95, f"levels agree in {agree}/{n}")
 
@@ -125,8 +131,8 @@ class Replay(unittest.TestCase):
         self.assertEqual([lv for _, lv in a], [lv for _, lv in b], "level sequences differ")
         for (ta, _), (tb, _) in zip(a, b):
             self.assertLessEqual(abs(ta - tb), 0.1 + 1e-6, (ta, tb))
-        # the nearest statuses (at most half a status period apart) give the same Hopf speed and the same margin
-        # plus speed (the speed itself may be one 10 Hz speed sample apart: 0.1 s x 6.4 km/h/s)
+        # statuses at most 0.03 s apart (the first such nodelet status) give the same Hopf speed and the same
+        # margin plus speed (the speed itself may be one 10 Hz speed sample apart: 0.1 s x 6.4 km/h/s)
         stamps = [m.header.stamp.to_sec() for m in nodelet]
         pairs = 0
         for m in node:
@@ -172,15 +178,8 @@ class Replay(unittest.TestCase):
         self.assertTrue({"margin_to_hopf_kmh", "amplitude_displacement_m", "frequency_hz", "damping_ratio"} <= fields)
 
     def test_margins_match_the_offline_reference(self):
-        times = [r["t_s"] for r in self.reference]
         agree_level = agree_margin = n = 0
-        for m in self.data_statuses():
-            t = m.header.stamp.to_sec() - T0
-            i = bisect.bisect_left(times, t)
-            cand = [self.reference[j] for j in (i - 1, i) if 0 <= j < len(times)]
-            r = min(cand, key=lambda c: abs(c["t_s"] - t))
-            if abs(r["t_s"] - t) > 0.05:
-                continue
+        for m, r in self.matched(self.reference, T0):  # the make_test_bag CSVs start at 0
             n += 1
             agree_level += LEVELS[m.level] == r["level"]
             if r["margin_hopf_kmh"] is not None and m.boundaries_valid:
