@@ -1,5 +1,5 @@
 // soak_probe: listens to hunting_monitor_node for a given time (scripts/soak) and prints JSON: statuses received
-// against the 20 Hz expected, the age of the newest acceleration sample behind each status on arrival (median,
+// against the 20 Hz expected (over the whole run, which includes the node's start, and after the warm-up), the age of the newest acceleration sample behind each status on arrival (median,
 // p99, max), the levels seen after a warm-up, and the node's own count of accepted samples (from /diagnostics).
 //   soak_probe SECONDS [WARMUP_SECONDS]
 #include <diagnostic_msgs/DiagnosticArray.h>
@@ -23,7 +23,7 @@ int main(int argc, char** argv) {
   ros::NodeHandle nh;
   std::mutex lock;
   std::vector<double> ages;
-  long statuses = 0, levels[5] = {0, 0, 0, 0, 0};
+  long statuses = 0, after_warmup = 0, levels[5] = {0, 0, 0, 0, 0};
   std::string samples = "0", rejected = "0", gaps = "0";
   const ros::WallTime start = ros::WallTime::now();
   ros::Subscriber sub = nh.subscribe<hunting_monitor::HuntingStatus>(
@@ -32,6 +32,7 @@ int main(int argc, char** argv) {
         std::lock_guard<std::mutex> g(lock);
         ++statuses;
         if ((ros::WallTime::now() - start).toSec() < warmup) return;
+        ++after_warmup;
         if (m->level < 5) ++levels[m->level];
         if (!m->accel_stamp.isZero()) ages.push_back((ros::Time::now() - m->accel_stamp).toSec());
       },
@@ -54,11 +55,12 @@ int main(int argc, char** argv) {
   std::lock_guard<std::mutex> g(lock);
   std::sort(ages.begin(), ages.end());
   const auto pct = [&](double p) { return ages.empty() ? -1.0 : 1e3 * ages[static_cast<size_t>(p * (ages.size() - 1))]; };
-  std::printf("{\"seconds\": %.0f, \"statuses\": %ld, \"statuses_expected\": %.0f, \"latency_ms_median\": %.3f, "
+  std::printf("{\"seconds\": %.0f, \"statuses\": %ld, \"statuses_expected\": %.0f, \"statuses_after_warmup\": %ld, "
+              "\"statuses_expected_after_warmup\": %.0f, \"latency_ms_median\": %.3f, "
               "\"latency_ms_p99\": %.3f, \"latency_ms_max\": %.3f, \"levels_after_warmup\": {\"NO_DATA\": %ld, \"OK\": "
               "%ld, \"WATCH\": %ld, \"WARN\": %ld, \"ALARM\": %ld}, \"node_samples_accepted\": %s, "
               "\"node_rejected_out_of_order\": %s, \"node_gaps\": %s}\n",
-              seconds, statuses, 20.0 * seconds, pct(0.5), pct(0.99), pct(1.0), levels[0], levels[1], levels[2],
+              seconds, statuses, 20.0 * seconds, after_warmup, 20.0 * (seconds - warmup), pct(0.5), pct(0.99), pct(1.0), levels[0], levels[1], levels[2],
               levels[3], levels[4], samples.c_str(), rejected.c_str(), gaps.c_str());
   return 0;
 }

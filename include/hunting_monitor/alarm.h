@@ -2,19 +2,28 @@
  * hunting_monitor - safety margins and alarm levels from the estimator, the hunting-mode margin and the boundary
  * tables (docs/MODEL.md sections 4-7, issue #9).
  *
- * The conicity in use is the margin's model-based estimate (margin.h) when there is one with a standard error of at
- * most conicity_max_se, else conicity_fallback (0: the vehicle's own lambda(0)). The Hopf speed then has an
- * interval [hopf_low, hopf_high]: the estimate's (its conicity -+ 2 standard errors), or the table's stated error
- * around the fallback's. The table gives, at the conicity in use and the current speed, the lowest speed with a
- * cycle, the unstable cycle bounding the basin of the stable origin (the edge) and the stable cycle beyond it.
- * Where the origin is unstable at the conicity in use but the speed is still inside the Hopf interval, the edge
- * is taken at the interval's optimistic end (the conicity whose Hopf speed is hopf_high): the amplitude decides.
+ * The conicity in use and the Hopf interval [hopf_low, hopf_high] the level uses come from what is known:
+ *  - identified: the margin's model-based estimate (margin.h) with a standard error of at most conicity_max_se: its
+ *    conicity and interval (the conicity -+ interval_z standard errors);
+ *  - before that, the prior: conicity_fallback (0: the vehicle's own lambda(0)) within the range the wheels may have
+ *    worn to, [conicity_prior_low, conicity_prior_high] (0: the fallback -+ HM_ALARM_PRIOR_HALFWIDTH): the interval is
+ *    the closed-form Hopf speeds at the range's ends (widened to hold the table's value at the fallback), never the
+ *    table's interpolation error alone;
+ *  - an estimate too uncertain to be used alone, or one of a vehicle that does not behave like its model
+ *    (model_mismatch), is not replaced by the narrower prior: the level uses the more cautious of the two (the lower
+ *    point, and the lower of each end);
+ *  - with model_mismatch the model-free interval (margin.h), when valid, bounds the level as well (the lower of each
+ *    end).
+ * The table gives, at the conicity in use and the current speed, the lowest speed with a cycle, the unstable cycle
+ * bounding the basin of the stable origin (the edge) and the stable cycle beyond it. Where the origin is unstable at
+ * the conicity in use but the speed is still inside the Hopf interval, the edge is taken at the interval's
+ * optimistic end (the conicity whose Hopf speed is hopf_high): the amplitude decides.
  *
  * The levels, and what each asks of the driver:
  *   NO_DATA  acceleration or speed stale or missing, or a sample rate the filters cannot use: the monitor cannot
  *            judge. Margins are not presented as current. Drive by the line's rules; report the fault.
- *   ALARM    hunting or its onset: a standard criterion met (sliding r.m.s., consecutive peaks, with the limits of
- *            the measurement point), the speed above the Hopf interval (the origin is unstable), or the displacement
+ *   ALARM    hunting or its onset: a criterion met (sliding r.m.s., consecutive peaks, with the limits of the
+ *            measurement point; the displacement amplitude at any frequency of the band, estimator.h), the speed above the Hopf interval (the origin is unstable), or the displacement
  *            amplitude at or beyond the edge. Reduce speed now, below the lower end of the Hopf interval.
  *   WARN     close to the boundary: the speed inside the Hopf interval or within warn_speed_margin_kmh below it, or
  *            the amplitude above warn_amplitude_fraction of the edge. Do not accelerate; reduce speed by the margin.
@@ -27,6 +36,13 @@
  * Thresholds of the current (or a higher) level are relaxed by the hysteresis (hysteresis_kmh on speeds,
  * hysteresis_amplitude_fraction of the edge on amplitudes), a higher level is taken at once, and a lower one only
  * after the conditions for it have held for min_hold_s: no chatter. Every change carries a reason code.
+ * Latching by cause (issue #21): an ALARM from the oscillation (a criterion, or the amplitude at or beyond the
+ * unstable cycle) is latched: it holds, with its reason, until the oscillation has stayed calm for release_s (no
+ * criterion met, the displacement amplitude below release_amplitude_fraction of the displacement criterion's limit,
+ * or of the edge where that limit is off) and the speed is below the lower end of the Hopf interval; the status says
+ * that the level is held and why (latched, release_in_s). A hunting wheelset's oscillation comes and goes with the
+ * track; the driver's "reduce speed now" must not. A speed-only ALARM follows the speed with the hysteresis. Stale
+ * input shows NO_DATA but keeps the latch: when data returns the ALARM is back until the calm is seen.
  */
 #ifndef HUNTING_MONITOR_ALARM_H
 #define HUNTING_MONITOR_ALARM_H
@@ -65,7 +81,8 @@ typedef enum {
   HM_REASON_APPROACHING_HOPF = 11,  /* WATCH: within watch_speed_margin_kmh of the Hopf interval */
   HM_REASON_MODEL_MISMATCH = 12,    /* WATCH: model-based and model-free Hopf speeds disagree */
   HM_REASON_RATE_MISMATCH = 13,     /* WATCH: the sensor delivers another rate than configured */
-  HM_REASON_BAD_SAMPLE_RATE = 14    /* NO_DATA: a sample rate the filters cannot be designed for */
+  HM_REASON_BAD_SAMPLE_RATE = 14,   /* NO_DATA: a sample rate the filters cannot be designed for */
+  HM_REASON_DISPLACEMENT_CRITERION = 15 /* ALARM: the displacement amplitude at or above its limit (any frequency) */
 } hm_reason;
 
 const char *hm_level_name(hm_level level);   /* "NO_DATA", "OK", ... */
@@ -81,10 +98,18 @@ typedef struct {
   int use_conicity_estimate;
   double conicity_max_se;               /* the estimate is used when its standard error is at most this */
   double conicity_fallback;             /* lambda(0) used otherwise; 0: the vehicle's own lambda(0) */
+  double conicity_prior_low;            /* the range the wheels may have worn to before identification: it must */
+  double conicity_prior_high;           /* hold the fallback; 0: the fallback -+ HM_ALARM_PRIOR_HALFWIDTH */
+  double release_s;                     /* an oscillation ALARM is released after this long calm [s] */
+  double release_amplitude_fraction;    /* calm: displacement below this fraction of the displacement limit */
 } hm_alarm_config;
 
+/* The prior's default half-width: new to worn wheels of a high-speed fleet move lambda(0) by about this (the default
+ * vehicle's measured 0.1358 to the issue's worn 0.16 is 0.024). */
+#define HM_ALARM_PRIOR_HALFWIDTH 0.03
+
 /* Defaults: 0.5, 10 km/h, 30 km/h, 3 km/h, 0.1, 3 s, estimate used up to a standard error of 0.01, fallback 0
- * (the vehicle's). */
+ * (the vehicle's), prior 0 / 0 (the fallback -+ 0.03), release after 10 s below half the displacement limit. */
 void hm_alarm_config_default(hm_alarm_config *cfg);
 hm_status hm_alarm_config_validate(const hm_alarm_config *cfg, char *why, size_t why_len);
 
@@ -95,7 +120,8 @@ typedef struct {
   int changed;                      /* the level changed in this update */
   double conicity;                  /* in use */
   double conicity_se;               /* its standard error (0 for the fallback) */
-  int conicity_from_estimate;
+  int conicity_from_estimate;       /* the identified conicity alone (else the prior, or the more cautious of both) */
+  int conicity_from_prior;          /* the prior's range sets the interval (no estimate, or one too uncertain) */
   int boundaries_valid;             /* 0 with NO_DATA: nothing below is current */
   hm_table_lookup_result boundaries;/* at the conicity in use and the current speed */
   double hopf_low_kmh, hopf_high_kmh; /* the Hopf interval the level uses */
@@ -104,6 +130,9 @@ typedef struct {
   double margin_lowest_cycle_kmh;   /* lowest cycle speed - speed (negative: inside the bistable band) */
   double amplitude_m;               /* measured displacement amplitude used */
   double amplitude_margin_m;        /* edge - amplitude (0 if no edge) */
+  int latched;                      /* an oscillation ALARM held until the oscillation stays calm and the speed drops */
+  double release_in_s;              /* calm still needed [s] (release_s while the oscillation or the speed is not
+                                       calm yet); 0 when not latched */
 } hm_assessment;
 
 typedef struct hm_alarm_s *hm_alarm;
@@ -122,6 +151,9 @@ hm_status hm_alarm_set_config(hm_alarm alarm, const hm_alarm_config *cfg, const 
 /* Look boundaries up in this table from the next update on (borrowed, as at create; the level is kept). */
 void hm_alarm_set_table(hm_alarm alarm, const hm_table table);
 
+/* The displacement criterion's limit [m] (estimator.h) that the latch's calm test scales (0, the default: the edge
+ * amplitude in use, or 2.1 mm without one). The monitor passes its estimator's. */
+void hm_alarm_set_displacement_limit(hm_alarm alarm, double displacement_limit_m);
 /* Evaluate at time now_s with the estimator's output and the margin's (margin may be NULL: no estimate).
  * HM_EINVAL for NULL arguments or a non-finite now; the table lookup's status if it fails. The alarm's state and
  * *out are untouched on failure. */

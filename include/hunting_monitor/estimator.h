@@ -25,13 +25,27 @@
  *    limits come from the model (docs/MODEL.md section 7): an oscillation of half the smallest unstable cycle
  *    from which the default vehicle can hunt (4.2 mm at the lower fold LPC1, so 2.1 mm) at the Hopf frequency
  *    (14.28 Hz, w^2 = 8050 1/s^2): r.m.s. 2.1e-3 x 8050 / sqrt(2) = 12 m/s^2, peak 2.1e-3 x 8050 = 17 m/s^2 in a
- *    2-20 Hz band that holds the hunting frequency; six consecutive peaks as in the bogie practice.
+ *    2-20 Hz band that holds the hunting frequency; six consecutive peaks as in the bogie practice. Those
+ *    acceleration limits hold the displacement to 2.1 mm at 14.3 Hz only: a bogie mode at 8 Hz reaches 3 mm with
+ *    7.6 m/s^2. So (c), on the wheelset, the displacement criterion: the tracked displacement amplitude (the
+ *    band-passed acceleration's amplitude over whole periods, corrected for the band's gain, over (2 pi f)^2) of a
+ *    coherent oscillation (period spread at most 0.2) at or above displacement_limit_m (2.1 mm, the same half of the
+ *    4.2 mm cycle) at any frequency of the 2-20 Hz band: a limit that depends neither on the frequency nor on the
+ *    boundary table;
  *    The identification of the hunting mode and the conicity are not here: modal.h, inversion.h, margin.h.
  * Sample rate: the filters are first designed for the configured sample_rate_hz, which is an expectation: the rate
- * is measured from the time stamps over blocks of 0.5 s of gap-free data, and when two blocks in a row differ from
- * the design by more than 2% the filters are redesigned for the measured rate (and restarted). A measured rate more
- * than 5% from the configured one is reported (sample_rate_mismatch); one the bands cannot be designed for (below
- * 100 Hz, above 5 kHz, or with a band edge above 0.45 of it) makes the acceleration invalid.
+ * is measured from the time stamps over blocks of 0.5 s of gap-free data: from regular stamps (a sensor's clock,
+ * below) the reciprocal of the median stamp difference (so samples lost or delivered late do not read as another
+ * rate: a count per block would), from irregular ones (receipt times in bursts) the count per time; when two
+ * blocks in a row differ from the design by more than 2% the filters are redesigned for the measured rate (and
+ * restarted). A measured rate more than 5% from the configured one is reported (sample_rate_mismatch); one the bands
+ * cannot be designed for (below 100 Hz, above 5 kHz, or with a band edge above 0.45 of it) makes the acceleration
+ * invalid.
+ * Lost samples: when a block's stamps are regular (95% of the differences within 0.25 periods of a whole number of
+ * median differences: a sensor's own clock; receipt times in bursts are not) at a rate within 2% of the design, a
+ * difference of k >= 2 periods (up to max_gap_s) counts k - 1 lost samples (n_samples_lost; loss_fraction over about
+ * the last 10 s) and is bridged by k - 1 linearly interpolated samples, so the filters, trackers and criteria stay on
+ * their time grid (hm_estimator_last_fill tells a consumer of the same stream how many).
  * Bad input is counted and skipped, never propagated: non-finite or implausibly large samples, repeated or
  * out-of-order timestamps, gaps longer than max_gap_s (which restart the filters and trackers), speeds that are
  * non-finite, negative, above max_speed_kmh or change by more than max_speed_rate_kmh_s x dt + max_speed_jump_kmh. Outputs are never NaN.
@@ -68,6 +82,7 @@ typedef struct {
   double peaks_band_low_hz, peaks_band_high_hz;
   double peaks_limit_mps2;
   unsigned peaks_count;
+  double displacement_limit_m;    /* (c): displacement amplitude limit [m]; 0: off (the bogie frame's default) */
   double max_gap_s;               /* a longer silence restarts filters and trackers */
   double accel_timeout_s;         /* acceleration older than this is stale */
   double speed_timeout_s;         /* speed older than this is stale */
@@ -93,6 +108,8 @@ typedef struct {
   double sample_rate_measured_hz; /* from the stamps, over the last half second of gap-free data (0 until then) */
   int sample_rate_mismatch;       /* measured differs from the configured sample_rate_hz by more than 5% */
   int sample_rate_supported;      /* the filters can be designed for the measured rate (else accel_valid is 0) */
+  int stamps_regular;             /* the last block's stamps lay on a grid: losses are counted and bridged */
+  double loss_fraction;           /* lost / (lost + received) samples over about the last 10 s */
   int accel_valid;                /* samples arrived within accel_timeout_s of `now` */
   int speed_valid;                /* a plausible speed arrived within speed_timeout_s of `now` */
   double speed_kmh;               /* last accepted speed (0 if none) */
@@ -106,8 +123,10 @@ typedef struct {
   int rms_exceeded;
   unsigned consecutive_peaks;
   int peaks_exceeded;
+  int displacement_exceeded;      /* (c) */
   /* input problems, counted since create or reset */
   unsigned long n_samples, n_rejected_nonfinite, n_rejected_range, n_rejected_order, n_gaps;
+  unsigned long n_samples_lost;   /* missing from a regular grid (bridged by interpolation) */
   unsigned long n_speed_updates, n_speed_rejected;
   unsigned long n_rate_changes;   /* filter redesigns for a measured rate */
 } hm_estimate;
@@ -120,7 +139,7 @@ hm_status hm_estimator_create(const hm_estimator_config *cfg, hm_estimator *out,
 void hm_estimator_destroy(hm_estimator est);
 /* Forget all state (filters, trackers, counters). */
 void hm_estimator_reset(hm_estimator est);
-/* The standard criteria's limits while running (rms_limit_mps2, peaks_limit_mps2, peaks_count of cfg; its other
+/* The standard criteria's limits while running (rms_limit_mps2, peaks_limit_mps2, peaks_count, displacement_limit_m of cfg; its other
  * fields are ignored), validated as hm_estimator_config_validate does (HM_EDOMAIN with the reason; nothing changes
  * then). The stream's state is kept. */
 hm_status hm_estimator_set_limits(hm_estimator est, const hm_estimator_config *cfg, char *why, size_t why_len);
@@ -131,6 +150,9 @@ unsigned long hm_estimator_restarts(const hm_estimator est, double *design_rate_
 /* One acceleration sample. HM_OK if accepted; HM_EDOMAIN if rejected and counted (non-finite, out of range, or a
  * timestamp not after the previous one): the state is unchanged then. HM_EINVAL only for a NULL estimator. */
 hm_status hm_estimator_push_accel(hm_estimator est, double t_s, double accel_mps2);
+/* How many samples were lost (and bridged by linear interpolation) just before the latest accepted one: a consumer
+ * of the same stream interpolates as many between the previous accepted sample and that one. */
+unsigned hm_estimator_last_fill(const hm_estimator est);
 /* One speed update [km/h]; rejected (HM_EDOMAIN) and counted if implausible. */
 hm_status hm_estimator_push_speed(hm_estimator est, double t_s, double speed_kmh);
 /* The estimate as of time now_s (staleness judged against it). Never NaN. */

@@ -3,25 +3,39 @@
  * (issue #9; docs/MODEL.md sections 2 and 5).
  *
  * Input: windows of data at a steady speed, each with its identified hunting mode (modal.h). A window is used when
- * its mode is valid, its speed varied by at most max_speed_spread_kmh, it is at min_speed_kmh or more, and it does
- * not overlap the previous window used (so that the windows' errors are independent). Windows older than memory_s
- * are forgotten (the wheels wear, the track changes).
+ * its mode is valid, its speed varied by at most max_speed_spread_kmh, it is at min_speed_kmh or more, it does not
+ * overlap the previous window used (so that the windows' errors are independent), and the model explains its decay
+ * rate and frequency together (the inversion's misfit chi2, one degree of freedom, at most max_misfit_chi2: else the
+ * window is a misfit, not used, and counted). Windows older than memory_s are forgotten (the wheels wear, the track
+ * changes).
+ * Change: a new window (committed or provisional) whose conicity differs from the mean of those held by more than
+ * change_z of their combined standard errors means the conicity changed (a worn section of rail, other wheels after a
+ * coupling): the windows held are dropped, the new one too (it may straddle the change), and the estimate starts
+ * again from the next window (n_changes, last_change_s). Windows that disagree less still widen the interval: the
+ * conicity's standard error is scaled by the Birge ratio sqrt(chi2 / (n - 1)) of the windows held when it exceeds 1.
  *
  * (a) Model-based. Each window's (decay rate, frequency, speed) is inverted jointly for the equivalent conicity
  *     (inversion.h). The errors passed to the inversion are the fit's statistical ones and a systematic part:
  *     frequency_model_error (relative: how far the model's hunting frequency may be from the vehicle's) and
- *     decay_rate_model_error (relative: the identification's bias, up to 5-10% on the two simulators, README). The
+ *     decay_rate_model_error (relative: the identification's bias, up to 5-10% on the two simulators, README) with,
+ *     added to it, 1 / T for a window of T seconds (the rectangular window's leakage widens the peak by about that:
+ *     near the Hopf speed, where |sigma| is small, it is the larger part). The
  *     windows' conicities are averaged with inverse-variance weights; the statistical part of the error shrinks
  *     with the number of windows, the systematic part does not. The Hopf speed and its interval are the closed-form
  *     critical speeds (linear.h) at lambda and at lambda -+ interval_z standard errors.
  * (b) Model-free. The decay rates measured at the speeds the train has run are regressed on 1/v (the model's
  *     damping terms scale with 1/v, so the hunting root's real part is nearly affine in 1/v: on the default vehicle
  *     the zero of the line through 420 and 460 km/h is 519 km/h, the true Hopf 517.6; through 460 and 500, 517.9)
- *     by weighted least squares; the Hopf speed is where the line reaches zero, with a delta-method interval. Valid
- *     with two or more windows spanning min_speed_span_kmh, a slope significantly negative, and the zero no more
- *     than max_extrapolation_kmh above the highest speed seen. A proportional bias of the decay rates does not move
- *     this zero.
- * When both are valid and their intervals do not overlap, the vehicle is not behaving like its model: model_mismatch.
+ *     by weighted least squares; the Hopf speed is where the line reaches zero, with Fieller's interval for the ratio
+ *     -alpha / beta (the delta method's symmetric interval is wrong when the slope is uncertain), at interval_z
+ *     standard errors with the stated errors, or at Student's t quantile of the same coverage with n - 2 degrees of
+ *     freedom when the residuals scale them up. The line's own error, the curvature of sigma(1/v), is added: the
+ *     model's hunting root at the vehicle's lambda(0) gives sigma'' and so the gap between the chord through the
+ *     windows' speeds and the curve at the zero. Valid with two or more windows spanning min_speed_span_kmh, a
+ *     slope significantly negative (Fieller's interval bounded), and the zero no more than max_extrapolation_kmh
+ *     above the highest speed seen. A proportional bias of the decay rates does not move this zero.
+ * model_mismatch, the vehicle not behaving like its model: both valid with disjoint intervals, or two or more
+ * misfit windows (a mode the model cannot produce at that speed, e.g. a bogie mode at 8 Hz) within memory_s.
  */
 #ifndef HUNTING_MONITOR_MARGIN_H
 #define HUNTING_MONITOR_MARGIN_H
@@ -48,9 +62,12 @@ typedef struct {
   double min_speed_span_kmh;     /* the model-free estimate needs windows this far apart in speed */
   double max_extrapolation_kmh;  /* ... and a zero at most this far above the highest speed seen */
   double interval_z;             /* intervals are +- this many standard errors */
+  double max_misfit_chi2;        /* a window the model explains worse than this (chi2, 1 dof) is a misfit */
+  double change_z;               /* a window this many combined standard errors from the mean is a change */
 } hm_margin_config;
 
-/* Defaults: 1%, 10%, 10 km/h, 200 km/h, 900 s, 20 km/h, 150 km/h, z = 2 (about 95%). */
+/* Defaults: 1%, 10%, 10 km/h, 200 km/h, 900 s, 20 km/h, 150 km/h, z = 2 (about 95%), misfit chi2 9 (3 standard
+ * errors), change at 4 standard errors. */
 void hm_margin_config_default(hm_margin_config *cfg);
 hm_status hm_margin_config_validate(const hm_margin_config *cfg, char *why, size_t why_len);
 
@@ -64,7 +81,11 @@ typedef struct {
   int hopf_free_valid;              /* (b) */
   double hopf_free_kmh, hopf_free_low_kmh, hopf_free_high_kmh;
   double speed_min_kmh, speed_max_kmh; /* speeds of the windows in memory */
-  int model_mismatch;               /* (a) and (b) valid with disjoint intervals */
+  double birge_ratio;               /* sqrt(chi2 / (n - 1)) of the windows' conicities (1 with fewer than 2) */
+  unsigned n_misfits;               /* misfit windows within memory_s */
+  unsigned long n_changes;          /* changes of the conicity detected (the windows dropped each time) */
+  double last_change_s;             /* when the last one was (0 if none) */
+  int model_mismatch;               /* (a) and (b) valid with disjoint intervals, or two or more misfits */
 } hm_margin_estimate;
 
 typedef enum {
@@ -73,7 +94,9 @@ typedef enum {
   HM_WINDOW_SPEED_VARIED = 2,
   HM_WINDOW_TOO_SLOW = 3,
   HM_WINDOW_OVERLAPS = 4,
-  HM_WINDOW_NO_INVERSION = 5
+  HM_WINDOW_NO_INVERSION = 5,
+  HM_WINDOW_MISFIT = 6,     /* the model explains its decay rate and frequency together no better than chi2 limit */
+  HM_WINDOW_CHANGE = 7      /* its conicity disagrees with the windows held: they were dropped, and so was it */
 } hm_window_verdict;
 
 typedef struct hm_margin_s *hm_margin;

@@ -12,10 +12,14 @@
  *    takes what is smooth across the band: the second, heavily damped pair of the same model (damping ratio about
  *    0.6 at the same frequency), the s^2 of acceleration, the filters and the colour of the track excitation, which
  *    differs between tracks and is not known.
+ *  - Lines are not the mode (issue #18): a comb of lines at multiples of V / L (rail joints, bridge spans, slabs;
+ *    lines.h, searched over 2.5 Hz to 0.3 of the decimated rate) is reported and its bins are left out of the fit, so
+ *    that a line on the mode's peak is never read as the mode's damping.
  *  - Whittle's log-likelihood  -sum(ln S_k + I_k / S_k)  is maximised by Fisher scoring with Levenberg damping
  *    (J = d ln S / d theta, step (J'J + mu D)^-1 J'(I/S - 1)), warm-started from the previous fit; converged when
  *    the objective changes by less than tol relative (failure: HM_ENOCONV after max_iter). The standard errors are
- *    the square roots of the diagonal of (J'J)^-1, Whittle's asymptotic covariance.
+ *    the square roots of the diagonal of (J'J)^-1, Whittle's asymptotic covariance, scaled by nfft / n: the bins of
+ *    a periodogram zero-padded from n to nfft points are not independent (about n of them are).
  *  - A stationary spectrum gives |sigma| but not its sign: the decay rate reported is -|sigma|. Growth (sigma > 0) is
  *    seen by the amplitude tracker and the alarm, not here.
  * Why not an AR model of the acceleration: the second mode at the same frequency and the double zero at DC of
@@ -46,9 +50,14 @@ typedef struct {
   double fit_interval_s;    /* a new fit after this much new data [s] */
   double tol;               /* relative change of the objective that ends the scoring */
   unsigned max_iter;        /* scoring step limit */
+  int reject_lines;         /* 1: leave the bins of a periodic track excitation (a comb of lines, lines.h) out */
+  double line_candidate_ratio;   /* lines.h: a candidate line is this far above its local background */
+  double line_min_fundamental_hz;/* lines.h: the comb's lowest spacing [Hz] */
+  unsigned line_min_harmonics;   /* lines.h: candidates on a comb needed to declare it */
 } hm_modal_config;
 
-/* Defaults: 40 s window (fits from 20 s), 100 Hz, band 6-22 Hz, a fit every second, tol 1e-10, 80 steps. */
+/* Defaults: 40 s window (fits from 20 s), 100 Hz, band 6-22 Hz, a fit every second, tol 1e-10, 80 steps; lines
+ * rejected (ratio 8, spacing from 1.5 Hz, three harmonics). */
 void hm_modal_config_default(hm_modal_config *cfg);
 /* HM_EDOMAIN with "field: reason" in why for an invalid configuration. */
 hm_status hm_modal_config_validate(const hm_modal_config *cfg, char *why, size_t why_len);
@@ -61,6 +70,13 @@ typedef struct {
   double damping_ratio, damping_ratio_se;      /* -sigma / |s| */
   double peak_to_mean;         /* the mode's spectral peak over the band's mean level (valid needs > 3) */
   unsigned iterations;         /* scoring steps of this fit */
+  /* a periodic excitation of the track found in the window (lines.h), whose bins the fit left out */
+  int lines_found;
+  double line_fundamental_hz;  /* the comb's spacing: V / L for a pattern every L metres */
+  unsigned line_harmonics;     /* candidate lines on it */
+  double line_strongest_hz;    /* its strongest line and that line's acceleration amplitude [m/s^2] */
+  double line_strongest_mps2;
+  double band_excluded_fraction; /* of the band's bins left out of the fit */
 } hm_mode_estimate;
 
 typedef struct hm_modal_s *hm_modal;

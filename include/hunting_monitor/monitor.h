@@ -11,7 +11,8 @@
  *    (hm_table_local_error) exceeds the tolerances, the exact family there is wanted (hm_monitor_table_wanted); the
  *    caller computes it with hm_table_refine, on another thread if it likes (the table is only read), and hands
  *    the result back (hm_monitor_replace_table). The monitor itself never blocks on a computation after create;
- *  - the identification follows the estimator: restarted after a gap, redesigned for a measured sample rate.
+ *  - the identification follows the estimator: restarted after a gap, redesigned for a measured sample rate, fed
+ *    the same interpolated samples where the estimator bridged lost ones.
  * At a steady speed the identification's windows go to the margin with the speed's mean and range: the current
  * stretch provisionally (from min_window_s), committed in full windows (window_s) and when the stretch ends.
  * No allocation after create.
@@ -59,6 +60,7 @@ typedef struct {
   double mode_speed_kmh;       /* mean speed over its window */
   double mode_speed_spread_kmh;/* and its range */
   hm_window_verdict mode_verdict; /* whether the margin used that window */
+  double line_wavelength_m;    /* a periodic excitation in that window (mode.lines_found): V / f1 [m]; 0 if none */
   hm_margin_estimate margin;   /* conicity, Hopf speed model-based and model-free, mismatch */
   hm_assessment assessment;    /* level, reason, boundaries and margins */
 } hm_monitor_status;

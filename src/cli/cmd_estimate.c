@@ -52,6 +52,8 @@ static void write_line(const hm_monitor_status *st, double t) {
   jw_int(&w, "reason_code", (long)s->reason);
   jw_string(&w, "reason", hm_reason_text(s->reason));
   jw_bool(&w, "level_changed", s->changed);
+  jw_bool(&w, "latched", s->latched);
+  jw_number(&w, "release_in_s", s->latched ? s->release_in_s : 0.0);
   jw_bool(&w, "speed_valid", e->speed_valid);
   jw_number(&w, "speed_kmh", e->speed_kmh);
   jw_bool(&w, "accel_valid", e->accel_valid);
@@ -72,6 +74,13 @@ static void write_line(const hm_monitor_status *st, double t) {
   jw_number(&w, "mode_speed_kmh", md->valid ? st->mode_speed_kmh : NAN);
   jw_number(&w, "mode_speed_spread_kmh", md->valid && st->mode_speed_spread_kmh >= 0.0 ? st->mode_speed_spread_kmh : NAN);
   jw_int(&w, "mode_window_verdict", (long)st->mode_verdict);
+  /* a periodic excitation of the track found in the latest window (its bins left out of the fit) */
+  jw_bool(&w, "lines_found", md->lines_found);
+  jw_number(&w, "line_fundamental_hz", md->lines_found ? md->line_fundamental_hz : NAN);
+  jw_number(&w, "line_wavelength_m", md->lines_found ? st->line_wavelength_m : NAN);
+  jw_int(&w, "line_harmonics", (long)md->line_harmonics);
+  jw_number(&w, "line_strongest_hz", md->lines_found ? md->line_strongest_hz : NAN);
+  jw_number(&w, "line_strongest_mps2", md->lines_found ? md->line_strongest_mps2 : NAN);
   jw_int(&w, "windows_used", (long)g->n_windows);
   /* the margin: model-based and model-free Hopf speeds */
   jw_bool(&w, "conicity_valid", g->conicity_valid);
@@ -85,9 +94,14 @@ static void write_line(const hm_monitor_status *st, double t) {
   jw_number(&w, "hopf_free_kmh_low", g->hopf_free_valid ? g->hopf_free_low_kmh : NAN);
   jw_number(&w, "hopf_free_kmh_high", g->hopf_free_valid ? g->hopf_free_high_kmh : NAN);
   jw_bool(&w, "model_mismatch", g->model_mismatch);
+  jw_number(&w, "birge_ratio", g->birge_ratio);
+  jw_int(&w, "misfit_windows", (long)g->n_misfits);
+  jw_int(&w, "conicity_changes", (long)g->n_changes);
+  jw_number(&w, "last_conicity_change_s", g->n_changes ? g->last_change_s : NAN);
   const int b = s->boundaries_valid; /* no margins are shown as current without data */
   jw_number(&w, "conicity_used", b ? s->conicity : NAN);
   jw_bool(&w, "conicity_from_estimate", b && s->conicity_from_estimate);
+  jw_bool(&w, "conicity_from_prior", b && s->conicity_from_prior);
   jw_number(&w, "hopf_kmh", b ? s->boundaries.hopf_speed_kmh : NAN);
   jw_number(&w, "hopf_kmh_low", b ? s->hopf_low_kmh : NAN);
   jw_number(&w, "hopf_kmh_high", b ? s->hopf_high_kmh : NAN);
@@ -101,8 +115,11 @@ static void write_line(const hm_monitor_status *st, double t) {
   jw_bool(&w, "rms_exceeded", e->rms_exceeded);
   jw_int(&w, "consecutive_peaks", (long)e->consecutive_peaks);
   jw_bool(&w, "peaks_exceeded", e->peaks_exceeded);
+  jw_bool(&w, "displacement_exceeded", e->displacement_exceeded);
   jw_int(&w, "rejected_samples", (long)(e->n_rejected_nonfinite + e->n_rejected_range + e->n_rejected_order));
   jw_int(&w, "gaps", (long)e->n_gaps);
+  jw_int(&w, "samples_lost", (long)e->n_samples_lost);
+  jw_number(&w, "samples_lost_fraction", e->loss_fraction);
   jw_int(&w, "rejected_speeds", (long)e->n_speed_rejected);
   jw_end_object(&w);
   jw_finish(&w);

@@ -6,17 +6,33 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "hunting_monitor/linear.h"
+
+/* The Hopf speed reported where the linear model is stable at every speed (as margin.c). */
+static const double NO_HOPF_KMH = 1e4;
+
 struct hm_alarm_s {
-  hm_alarm_config cfg;
+  hm_alarm_config cfg;            /* fallback and prior resolved for the vehicle */
+  hm_vehicle veh;
+  double prior_hopf_low_kmh, prior_hopf_high_kmh; /* closed-form Hopf speeds at the prior's high and low ends */
   hm_table table;
   hm_level level;
   hm_reason reason;
   double since;
   int lower_pending;      /* the conditions for a lower level hold since lower_since */
   double lower_since;
-  int have_lookup;        /* the last table lookups, reused while conicities and speed are unchanged */
-  double lookup_conicity, lookup_opt_conicity, lookup_speed;
-  hm_table_lookup_result lookup, lookup_opt;
+  int latched;            /* an oscillation ALARM held (alarm.h) */
+  hm_reason latch_reason;
+  int calm;               /* the release conditions hold since calm_since */
+  double calm_since;
+  double displacement_limit_m; /* the displacement criterion's limit (0: off) */
+  /* the last table lookups (at the conicity in use and at the interval's optimistic end), reused while their
+   * conicity and the speed are unchanged */
+  struct {
+    int valid;
+    double conicity, speed_kmh;
+    hm_table_lookup_result r;
+  } cache[2];
 };
 
 const char *hm_level_name(hm_level l) {
@@ -41,6 +57,7 @@ const char *hm_reason_text(hm_reason r) {
     case HM_REASON_MODEL_MISMATCH: return "the vehicle does not behave like its model";
     case HM_REASON_RATE_MISMATCH: return "the sensor delivers another sample rate than configured";
     case HM_REASON_BAD_SAMPLE_RATE: return "acceleration at a sample rate the filters cannot use";
+    case HM_REASON_DISPLACEMENT_CRITERION: return "displacement amplitude criterion exceeded";
   }
   return "?";
 }
@@ -55,6 +72,10 @@ void hm_alarm_config_default(hm_alarm_config *c) {
   c->use_conicity_estimate = 1;
   c->conicity_max_se = 0.01;
   c->conicity_fallback = 0.0;
+  c->conicity_prior_low = 0.0;
+  c->conicity_prior_high = 0.0;
+  c->release_s = 10.0;
+  c->release_amplitude_fraction = 0.5;
 }
 
 hm_status hm_alarm_config_validate(const hm_alarm_config *c, char *why, size_t len) {
@@ -79,20 +100,66 @@ hm_status hm_alarm_config_validate(const hm_alarm_config *c, char *why, size_t l
     field = "conicity_max_se", rule = "must be in (0, 1]", got = c->conicity_max_se;
   else if (!(c->conicity_fallback >= 0.0 && c->conicity_fallback <= 10.0))
     field = "conicity_fallback", rule = "must be in [0, 10]", got = c->conicity_fallback;
+  else if (!(c->conicity_prior_low >= 0.0 && c->conicity_prior_low <= 10.0))
+    field = "conicity_prior_low", rule = "must be in [0, 10]", got = c->conicity_prior_low;
+  else if (!(c->conicity_prior_high >= 0.0 && c->conicity_prior_high <= 10.0))
+    field = "conicity_prior_high", rule = "must be in [0, 10]", got = c->conicity_prior_high;
+  else if (!(c->release_s >= 0.0 && c->release_s <= 3600.0))
+    field = "release_s", rule = "must be in [0, 3600]", got = c->release_s;
+  else if (!(c->release_amplitude_fraction > 0.0 && c->release_amplitude_fraction <= 1.0))
+    field = "release_amplitude_fraction", rule = "must be in (0, 1]", got = c->release_amplitude_fraction;
+  else if ((c->conicity_prior_low == 0.0) != (c->conicity_prior_high == 0.0) ||
+           (c->conicity_prior_high != 0.0 && !(c->conicity_prior_high > c->conicity_prior_low)))
+    field = "conicity_prior_high", rule = "must be above conicity_prior_low (or both 0: the fallback -+ 0.03)",
+    got = c->conicity_prior_high;
   if (!field) return HM_OK;
   if (why && len) snprintf(why, len, "%s: out of range: %s (got %g)", field, rule, got);
   return HM_EDOMAIN;
 }
 
+static double hopf_kmh(const hm_vehicle *veh, double conicity) {
+  double v_mps;
+  if (!(conicity > 0.0) || hm_linear_critical_speed(veh, conicity, &v_mps) != HM_OK) return NO_HOPF_KMH;
+  return fmin(hm_kmh_from_mps(v_mps), NO_HOPF_KMH);
+}
+
+/* The configuration with the fallback and the prior resolved for the vehicle, and the prior's Hopf speeds; HM_EDOMAIN
+ * (reason in why) for a prior that does not hold the fallback. */
+static hm_status resolve(const hm_alarm_config *cfg, const hm_vehicle *veh, hm_alarm_config *out, double *hopf_low,
+                         double *hopf_high, char *why, size_t len) {
+  hm_status st = hm_alarm_config_validate(cfg, why, len);
+  if (st != HM_OK) return st;
+  hm_alarm_config c = *cfg;
+  if (c.conicity_fallback == 0.0) hm_conicity_eval(&veh->conicity, 0.0, &c.conicity_fallback, NULL);
+  if (c.conicity_prior_low == 0.0 && c.conicity_prior_high == 0.0) {
+    c.conicity_prior_low = fmax(c.conicity_fallback - HM_ALARM_PRIOR_HALFWIDTH, 0.5 * c.conicity_fallback);
+    c.conicity_prior_high = c.conicity_fallback + HM_ALARM_PRIOR_HALFWIDTH;
+  }
+  if (!(c.conicity_prior_low <= c.conicity_fallback && c.conicity_fallback <= c.conicity_prior_high)) {
+    if (why && len)
+      snprintf(why, len, "conicity_prior_low, conicity_prior_high: must hold the fallback conicity %g (got %g..%g)",
+               c.conicity_fallback, c.conicity_prior_low, c.conicity_prior_high);
+    return HM_EDOMAIN;
+  }
+  *out = c;
+  *hopf_low = hopf_kmh(veh, c.conicity_prior_high);
+  *hopf_high = hopf_kmh(veh, c.conicity_prior_low);
+  return HM_OK;
+}
+
 hm_status hm_alarm_create(const hm_alarm_config *cfg, const hm_vehicle *veh, const hm_table table, hm_alarm *out,
                           char *why, size_t why_len) {
   if (!cfg || !veh || !table || !out) return HM_EINVAL;
-  hm_status st = hm_alarm_config_validate(cfg, why, why_len);
+  hm_alarm_config c;
+  double lo, hi;
+  hm_status st = resolve(cfg, veh, &c, &lo, &hi, why, why_len);
   if (st != HM_OK) return st;
   hm_alarm a = calloc(1, sizeof *a);
   if (!a) return HM_ENOMEM;
-  a->cfg = *cfg;
-  if (a->cfg.conicity_fallback == 0.0) hm_conicity_eval(&veh->conicity, 0.0, &a->cfg.conicity_fallback, NULL);
+  a->cfg = c;
+  a->veh = *veh;
+  a->prior_hopf_low_kmh = lo;
+  a->prior_hopf_high_kmh = hi;
   a->table = table;
   a->level = HM_LEVEL_NO_DATA;
   a->reason = HM_REASON_STARTUP;
@@ -108,24 +175,48 @@ void hm_alarm_reset(hm_alarm a) {
   a->reason = HM_REASON_STARTUP;
   a->since = 0.0;
   a->lower_pending = 0;
-  a->have_lookup = 0;
+  a->latched = a->calm = 0;
+  a->cache[0].valid = a->cache[1].valid = 0;
+}
+
+void hm_alarm_set_displacement_limit(hm_alarm a, double limit_m) {
+  if (a && isfinite(limit_m) && limit_m >= 0.0) a->displacement_limit_m = limit_m;
+}
+
+/* An ALARM caused by the oscillation itself (latched), not by the speed alone. */
+static int oscillation_reason(hm_reason r) {
+  return r == HM_REASON_RMS_CRITERION || r == HM_REASON_PEAKS_CRITERION || r == HM_REASON_DISPLACEMENT_CRITERION ||
+         r == HM_REASON_AMPLITUDE_BEYOND_EDGE;
+}
+
+/* The latch's release conditions: no criterion, the oscillation small, the speed below the Hopf interval. */
+static int calm_now(const hm_alarm a, const hm_estimate *e, const hm_assessment *s) {
+  const double f = a->cfg.release_amplitude_fraction;
+  const double limit = a->displacement_limit_m > 0.0 ? a->displacement_limit_m : s->edge_used_m;
+  const int small = limit > 0.0 ? s->amplitude_m < f * limit : s->amplitude_m < f * 2.1e-3;
+  return !e->rms_exceeded && !e->peaks_exceeded && !e->displacement_exceeded && small &&
+         e->speed_kmh < s->hopf_low_kmh;
 }
 
 hm_status hm_alarm_set_config(hm_alarm a, const hm_alarm_config *cfg, const hm_vehicle *veh, char *why,
                               size_t why_len) {
   if (!a || !cfg || !veh) return HM_EINVAL;
-  const hm_status st = hm_alarm_config_validate(cfg, why, why_len);
+  hm_alarm_config c;
+  double lo, hi;
+  const hm_status st = resolve(cfg, veh, &c, &lo, &hi, why, why_len);
   if (st != HM_OK) return st;
-  a->cfg = *cfg;
-  if (a->cfg.conicity_fallback == 0.0) hm_conicity_eval(&veh->conicity, 0.0, &a->cfg.conicity_fallback, NULL);
-  a->have_lookup = 0; /* the conicity in use may change with the settings */
+  a->cfg = c;
+  a->veh = *veh;
+  a->prior_hopf_low_kmh = lo;
+  a->prior_hopf_high_kmh = hi;
+  a->cache[0].valid = a->cache[1].valid = 0; /* the conicity in use may change with the settings */
   return HM_OK;
 }
 
 void hm_alarm_set_table(hm_alarm a, const hm_table table) {
   if (!a || !table) return;
   a->table = table;
-  a->have_lookup = 0; /* the cached lookups were the old table's */
+  a->cache[0].valid = a->cache[1].valid = 0; /* the cached lookups were the old table's */
 }
 
 /* The level the conditions call for, with the thresholds of levels at or below `current` relaxed. */
@@ -140,6 +231,7 @@ static hm_level raw_level(const hm_alarm a, const hm_estimate *e, const hm_margi
   const double ha_warn = current >= HM_LEVEL_WARN ? c->hysteresis_amplitude_fraction : 0.0;
   if (e->rms_exceeded) return *reason = HM_REASON_RMS_CRITERION, HM_LEVEL_ALARM;
   if (e->peaks_exceeded) return *reason = HM_REASON_PEAKS_CRITERION, HM_LEVEL_ALARM;
+  if (e->displacement_exceeded) return *reason = HM_REASON_DISPLACEMENT_CRITERION, HM_LEVEL_ALARM;
   if (v > s->hopf_high_kmh - hv_alarm) return *reason = HM_REASON_ABOVE_HOPF, HM_LEVEL_ALARM;
   if (edge > 0.0 && amp >= edge * (1.0 - ha_alarm)) return *reason = HM_REASON_AMPLITUDE_BEYOND_EDGE, HM_LEVEL_ALARM;
   if (edge > 0.0 && amp >= edge * (c->warn_amplitude_fraction - ha_warn))
@@ -153,49 +245,72 @@ static hm_level raw_level(const hm_alarm a, const hm_estimate *e, const hm_margi
   return *reason = HM_REASON_NORMAL, HM_LEVEL_OK;
 }
 
+/* The table's boundaries at (conicity, speed) through cache slot k; the Hopf speed is the closed form's where the
+ * conicity lies outside the table (a clamped lookup's would belong to another conicity). */
+static hm_status lookup(hm_alarm a, int k, double conicity, double speed_kmh, hm_table_lookup_result *out) {
+  if (a->cache[k].valid && a->cache[k].conicity == conicity && a->cache[k].speed_kmh == speed_kmh) {
+    *out = a->cache[k].r;
+    return HM_OK;
+  }
+  hm_table_lookup_result r;
+  const hm_status st = hm_table_lookup(a->table, conicity, speed_kmh, &r);
+  if (st != HM_OK) return st;
+  if (r.conicity != conicity) r.hopf_speed_kmh = hopf_kmh(&a->veh, conicity);
+  a->cache[k].valid = 1;
+  a->cache[k].conicity = conicity;
+  a->cache[k].speed_kmh = speed_kmh;
+  a->cache[k].r = r;
+  *out = r;
+  return HM_OK;
+}
+
 /* The conicity in use, the Hopf interval and the boundaries at the current speed; the table's status on failure. */
 static hm_status assess(hm_alarm a, const hm_estimate *e, const hm_margin_estimate *g, hm_assessment *s) {
   const hm_alarm_config *c = &a->cfg;
-  const int use = c->use_conicity_estimate && g && g->conicity_valid && g->hopf_model_valid &&
-                  g->conicity_se <= c->conicity_max_se;
-  s->conicity_from_estimate = use;
-  s->conicity = use ? g->conicity : c->conicity_fallback;
-  s->conicity_se = use ? g->conicity_se : 0.0;
+  const int have = c->use_conicity_estimate && g && g->conicity_valid && g->hopf_model_valid;
+  /* a vehicle that does not behave like its model gets no model-based interval narrower than the prior */
+  const int precise = have && g->conicity_se <= c->conicity_max_se && !g->model_mismatch;
+  /* the prior's interval, and the uncertain estimate's where it is the more cautious */
+  double lambda = c->conicity_fallback, lambda_opt = c->conicity_prior_low;
+  double lo = a->prior_hopf_low_kmh, hi = a->prior_hopf_high_kmh;
+  s->conicity_from_estimate = precise;
+  s->conicity_from_prior = !precise;
+  s->conicity_se = 0.0;
+  if (precise) {
+    lambda = g->conicity;
+    lambda_opt = g->conicity_low;
+    lo = g->hopf_model_low_kmh;
+    hi = g->hopf_model_high_kmh;
+    s->conicity_se = g->conicity_se;
+  } else if (have) {
+    if (g->hopf_model_kmh < hopf_kmh(&a->veh, lambda)) lambda = g->conicity, s->conicity_se = g->conicity_se;
+    lo = fmin(lo, g->hopf_model_low_kmh);
+    if (g->hopf_model_high_kmh < hi) hi = g->hopf_model_high_kmh, lambda_opt = g->conicity_low;
+  }
+  if (g && g->model_mismatch && g->hopf_free_valid) { /* then the model-free interval bounds the level too */
+    lo = fmin(lo, g->hopf_free_low_kmh);
+    if (g->hopf_free_high_kmh < hi) hi = g->hopf_free_high_kmh;
+  }
+  s->conicity = lambda;
   hm_table_lookup_result b, bo;
-  if (a->have_lookup && a->lookup_conicity == s->conicity && a->lookup_speed == e->speed_kmh) {
-    b = a->lookup;
-  } else {
-    const hm_status st = hm_table_lookup(a->table, s->conicity, e->speed_kmh, &b);
-    if (st != HM_OK) return st;
+  hm_status st = lookup(a, 0, lambda, e->speed_kmh, &b);
+  if (st != HM_OK) return st;
+  if (!precise) { /* the table's value at the point is inside the interval it is shown with */
+    lo = fmin(lo, b.hopf_speed_kmh - b.error_speed_kmh);
+    hi = fmax(hi, b.hopf_speed_kmh + b.error_speed_kmh);
   }
-  if (use) {
-    s->hopf_low_kmh = g->hopf_model_low_kmh;
-    s->hopf_high_kmh = g->hopf_model_high_kmh;
-  } else {
-    s->hopf_low_kmh = b.hopf_speed_kmh - b.error_speed_kmh;
-    s->hopf_high_kmh = b.hopf_speed_kmh + b.error_speed_kmh;
-  }
+  s->hopf_low_kmh = fmin(lo, b.hopf_speed_kmh);
+  s->hopf_high_kmh = fmax(hi, b.hopf_speed_kmh);
   s->boundaries = b;
   /* the edge: at the conicity in use where the origin is stable there; inside the Hopf interval above the point
    * estimate, at the interval's optimistic end (found by the lookup at the conicity whose Hopf speed is hopf_high,
    * which the table's affine 1/V^2 makes exact) */
   s->edge_used_m = b.has_edge ? b.edge_amp_m : 0.0;
-  if (!b.origin_stable && e->speed_kmh <= s->hopf_high_kmh && use) {
-    const double lambda_opt = g->conicity_low;
-    if (a->have_lookup && a->lookup_opt_conicity == lambda_opt && a->lookup_speed == e->speed_kmh) {
-      bo = a->lookup_opt;
-    } else {
-      const hm_status st = hm_table_lookup(a->table, lambda_opt, e->speed_kmh, &bo);
-      if (st != HM_OK) return st;
-    }
-    a->lookup_opt = bo;
-    a->lookup_opt_conicity = lambda_opt;
+  if (!b.origin_stable && e->speed_kmh <= s->hopf_high_kmh) {
+    st = lookup(a, 1, lambda_opt, e->speed_kmh, &bo);
+    if (st != HM_OK) return st;
     s->edge_used_m = bo.origin_stable && bo.has_edge ? bo.edge_amp_m : 0.0;
   }
-  a->lookup = b;
-  a->lookup_conicity = s->conicity;
-  a->lookup_speed = e->speed_kmh;
-  a->have_lookup = 1;
   return HM_OK;
 }
 
@@ -220,7 +335,26 @@ hm_status hm_alarm_update(hm_alarm a, const hm_estimate *e, const hm_margin_esti
     s.amplitude_m = e->oscillation_valid ? e->amplitude_displacement_m : 0.0;
     s.amplitude_margin_m = s.edge_used_m > 0.0 ? s.edge_used_m - s.amplitude_m : 0.0;
     target = raw_level(a, e, g, &s, a->level, &reason);
+    if (target == HM_LEVEL_ALARM && oscillation_reason(reason)) {
+      a->latched = 1;
+      a->latch_reason = reason;
+      a->calm = 0;
+    } else if (a->latched) {
+      /* held until calm for release_s */
+      const int calm = calm_now(a, e, &s);
+      if (!calm) a->calm = 0;
+      else if (!a->calm) a->calm = 1, a->calm_since = now;
+      if (a->calm && now - a->calm_since >= c->release_s) {
+        a->latched = 0;
+      } else {
+        target = HM_LEVEL_ALARM;
+        reason = a->latch_reason;
+        s.release_in_s = a->calm ? c->release_s - (now - a->calm_since) : c->release_s;
+      }
+    }
+    s.latched = a->latched;
   }
+  /* (with no data the latch is kept: nothing says the oscillation has gone) */
   s.changed = 0;
   if (target >= a->level || target == HM_LEVEL_NO_DATA || a->level == HM_LEVEL_NO_DATA) {
     a->lower_pending = 0;

@@ -319,6 +319,7 @@ static const settings_field estimator_fields[] = {
     EST(rms_window_m, FIELD_DOUBLE),         EST(rms_limit_mps2, FIELD_DOUBLE),
     EST(peaks_band_low_hz, FIELD_DOUBLE),    EST(peaks_band_high_hz, FIELD_DOUBLE),
     EST(peaks_limit_mps2, FIELD_DOUBLE),     EST(peaks_count, FIELD_UNSIGNED),
+    EST(displacement_limit_m, FIELD_DOUBLE),
     EST(max_gap_s, FIELD_DOUBLE),
     EST(accel_timeout_s, FIELD_DOUBLE),      EST(speed_timeout_s, FIELD_DOUBLE),
     EST(max_speed_kmh, FIELD_DOUBLE),        EST(max_speed_rate_kmh_s, FIELD_DOUBLE),
@@ -330,6 +331,8 @@ static const settings_field modal_fields[] = {
     MOD(window_s, FIELD_DOUBLE),       MOD(min_window_s, FIELD_DOUBLE), MOD(decimated_rate_hz, FIELD_DOUBLE),
     MOD(band_low_hz, FIELD_DOUBLE),    MOD(band_high_hz, FIELD_DOUBLE), MOD(fit_interval_s, FIELD_DOUBLE),
     MOD(tol, FIELD_DOUBLE),            MOD(max_iter, FIELD_UNSIGNED),
+    MOD(reject_lines, FIELD_BOOL),     MOD(line_candidate_ratio, FIELD_DOUBLE),
+    MOD(line_min_fundamental_hz, FIELD_DOUBLE), MOD(line_min_harmonics, FIELD_UNSIGNED),
 };
 
 static const settings_field margin_fields[] = {
@@ -337,6 +340,7 @@ static const settings_field margin_fields[] = {
     MAR(max_speed_spread_kmh, FIELD_DOUBLE),  MAR(min_speed_kmh, FIELD_DOUBLE),
     MAR(memory_s, FIELD_DOUBLE),              MAR(min_speed_span_kmh, FIELD_DOUBLE),
     MAR(max_extrapolation_kmh, FIELD_DOUBLE), MAR(interval_z, FIELD_DOUBLE),
+    MAR(max_misfit_chi2, FIELD_DOUBLE),       MAR(change_z, FIELD_DOUBLE),
 };
 
 static const settings_field alarm_fields[] = {
@@ -345,6 +349,8 @@ static const settings_field alarm_fields[] = {
     ALM(hysteresis_amplitude_fraction, FIELD_DOUBLE),
     ALM(min_hold_s, FIELD_DOUBLE),              ALM(use_conicity_estimate, FIELD_BOOL),
     ALM(conicity_max_se, FIELD_DOUBLE),         ALM(conicity_fallback, FIELD_DOUBLE),
+    ALM(conicity_prior_low, FIELD_DOUBLE),      ALM(conicity_prior_high, FIELD_DOUBLE),
+    ALM(release_s, FIELD_DOUBLE),               ALM(release_amplitude_fraction, FIELD_DOUBLE),
 };
 
 static const settings_field table_fields[] = {

@@ -9,6 +9,7 @@
 
 #include "hunting_monitor/linear.h"
 #include "biquad.h"
+#include "select.h"
 #include "hunting_monitor/criteria.h"
 
 enum { BAND_SECTIONS = 4 };
@@ -33,16 +34,31 @@ struct hm_estimator_s {
   /* the tracked oscillation as of the last crossing (the crossing ring changes only there) */
   double trk_f, trk_spread, trk_amp;
   hm_estimate counters;          /* only the counters are used */
-  /* sample rate: the filters are designed for design_rate_hz, measured from the stamps over blocks of
-   * RATE_BLOCK_S; two blocks in a row off by more than RATE_REDESIGN_TOL redesign them */
+  /* sample rate: the filters are designed for design_rate_hz; the rate is measured as the reciprocal of the median
+   * stamp difference over blocks of RATE_BLOCK_S (so lost or late samples do not read as another rate); two blocks
+   * in a row off by more than RATE_REDESIGN_TOL redesign them */
   double design_rate_hz, measured_rate_hz;
-  double blk_t0, blk_n;
+  double blk_t0;
+  double *blk_dt;                /* the block's stamp differences (scratch for the median) */
+  size_t blk_n, blk_cap;
   int off_blocks;
+  int stamps_regular;            /* the last block's stamps lay on a grid (losses can be counted and bridged) */
   unsigned long n_restarts;      /* filter restarts (gaps, redesigns, resets) */
+  /* lost samples: stamp differences of k >= 2 periods on a regular grid; bridged by k - 1 interpolated samples */
+  double a_prev;                 /* the previous accepted sample */
+  unsigned last_fill;            /* samples interpolated before the latest accepted one */
+  double blk_lost, blk_got;      /* this block's lost and received samples */
+  double loss_lost, loss_got;    /* the same, averaged over about LOSS_MEMORY_S */
 };
 
 enum { RATE_BLOCKS_TO_REDESIGN = 2 };
 static const double RATE_BLOCK_S = 0.5, RATE_REDESIGN_TOL = 0.02, RATE_MISMATCH_TOL = 0.05;
+/* a block's stamps are regular when this fraction of its differences lie within GRID_TOL periods of a whole number
+ * (1 or more) of median differences: a sensor's own clock, not receipt times in bursts */
+static const double GRID_FRACTION = 0.95, GRID_TOL = 0.25;
+/* the block buffer holds RATE_BLOCK_S at this rate (a faster stream ends its blocks early) */
+static const double RATE_BLOCK_MAX_HZ = 10000.0;
+static const double LOSS_MEMORY_S = 10.0;
 
 void hm_estimator_config_criteria(hm_estimator_config *c, hm_measurement_point point) {
   c->measurement_point = point;
@@ -51,11 +67,13 @@ void hm_estimator_config_criteria(hm_estimator_config *c, hm_measurement_point p
     c->peaks_band_low_hz = 0.5;
     c->peaks_band_high_hz = 10.0;
     c->peaks_limit_mps2 = 8.0;
+    c->displacement_limit_m = 0.0; /* the frame's displacement is not the wheelset's */
   } else { /* the wheelset: from the model (estimator.h) */
     c->rms_limit_mps2 = 12.0;
     c->peaks_band_low_hz = 2.0;
     c->peaks_band_high_hz = 20.0;
     c->peaks_limit_mps2 = 17.0;
+    c->displacement_limit_m = 2.1e-3;
   }
   c->peaks_count = 6;
 }
@@ -116,6 +134,8 @@ hm_status hm_estimator_config_validate(const hm_estimator_config *c, char *why, 
   if (c->measurement_point != HM_POINT_WHEELSET && c->measurement_point != HM_POINT_BOGIE_FRAME)
     return bad(why, len, "measurement_point", "must be wheelset or bogie_frame", (double)c->measurement_point);
   if (c->peaks_count < 1 || c->peaks_count > 1000) return bad(why, len, "peaks_count", "must be 1..1000", c->peaks_count);
+  if (!(c->displacement_limit_m >= 0.0 && c->displacement_limit_m <= 0.05))
+    return bad(why, len, "displacement_limit_m", "must be in [0, 0.05] (0: off)", c->displacement_limit_m);
   if (c->max_gap_s < 2.0 / fs) return bad(why, len, "max_gap_s", "must be at least two sample periods", c->max_gap_s);
   /* upper bounds: the buffers are sized from these (estimator.h states the memory they bound) */
   const struct {
@@ -152,8 +172,10 @@ static void restart_signal(hm_estimator e) {
   e->trk_spread = 1.0;
   e->armed = 0;
   hm_criteria_restart(e->criteria, fs);
-  e->blk_n = 0.0;
+  e->blk_n = 0;
+  e->blk_lost = e->blk_got = 0.0;
   e->off_blocks = 0;
+  e->last_fill = 0;
 }
 
 /* The rate the filters can be designed for: the bands below 0.45 of it, and 100..5000 Hz. */
@@ -161,16 +183,32 @@ static int rate_supported(const hm_estimator_config *c, double fs) {
   return fs >= 100.0 && fs <= 5000.0 && c->band_high_hz < 0.45 * fs && c->peaks_band_high_hz < 0.45 * fs;
 }
 
-/* Called per accepted sample after a first one, with no gap since the last: block rate measurement, and a
- * redesign on a lasting change (the stream at another rate than configured: filters designed for the wrong
- * rate put the band elsewhere, issue #9 item 5). */
-static void measure_rate(hm_estimator e, double t) {
-  if (e->blk_n == 0.0) e->blk_t0 = e->t_last;
-  e->blk_n += 1.0;
-  const double span = t - e->blk_t0;
-  if (span < RATE_BLOCK_S) return;
-  e->measured_rate_hz = e->blk_n / span;
-  e->blk_n = 0.0;
+/* The end of a rate block (at the sample at t): the share of differences on the grid of the median difference says
+ * whether the stamps are regular; the rate is then the median's (lost samples do not change it), else the block's
+ * mean; the block's losses enter the averaged loss fraction. */
+static void end_block(hm_estimator e, double t) {
+  int regular = 0;
+  double period = 0.0;
+  const double mean_period = e->blk_n > 0 ? (t - e->blk_t0) / (double)e->blk_n : 0.0;
+  if (e->blk_n >= 8) {
+    size_t on_grid = 0;
+    period = hm_select_kth(e->blk_dt, e->blk_n, e->blk_n / 2);
+    for (size_t k = 0; k < e->blk_n; ++k) {
+      const double q = e->blk_dt[k] / period, r = floor(q + 0.5);
+      if (r >= 1.0 && fabs(q - r) <= GRID_TOL) ++on_grid;
+    }
+    regular = (double)on_grid >= GRID_FRACTION * (double)e->blk_n;
+  }
+  /* irregular stamps (receipt times, which come in bursts): their median is no period; their mean is */
+  if (!regular) period = mean_period;
+  const double decay = exp(-RATE_BLOCK_S / LOSS_MEMORY_S);
+  e->loss_lost = decay * e->loss_lost + e->blk_lost;
+  e->loss_got = decay * e->loss_got + e->blk_got;
+  e->blk_n = 0;
+  e->blk_lost = e->blk_got = 0.0;
+  if (!(period > 0.0)) return;
+  e->measured_rate_hz = 1.0 / period;
+  e->stamps_regular = regular;
   const int off = fabs(e->measured_rate_hz / e->design_rate_hz - 1.0) > RATE_REDESIGN_TOL;
   e->off_blocks = off ? e->off_blocks + 1 : 0;
   if (e->off_blocks >= RATE_BLOCKS_TO_REDESIGN && rate_supported(&e->cfg, e->measured_rate_hz)) {
@@ -178,6 +216,25 @@ static void measure_rate(hm_estimator e, double t) {
     e->counters.n_rate_changes++;
     restart_signal(e); /* the filters' state belongs to the old design */
   }
+}
+
+/* Called per accepted sample after a first one, with no gap since the last: the block's stamp differences, and a
+ * redesign on a lasting change (the stream at another rate than configured: filters designed for the wrong
+ * rate put the band elsewhere, issue #9 item 5). */
+static void measure_rate(hm_estimator e, double t) {
+  if (e->blk_n == 0) e->blk_t0 = e->t_last;
+  e->blk_dt[e->blk_n++] = t - e->t_last;
+  if (t - e->blk_t0 >= RATE_BLOCK_S || e->blk_n == e->blk_cap) end_block(e, t);
+}
+
+/* Samples lost before one arriving dt after the last: k - 1 for a difference of k >= 2 periods of a confirmed grid
+ * (regular stamps at a measured rate within RATE_REDESIGN_TOL of the design), else 0. */
+static unsigned lost_before(const hm_estimator e, double dt) {
+  if (!e->stamps_regular || !(e->measured_rate_hz > 0.0) ||
+      fabs(e->measured_rate_hz / e->design_rate_hz - 1.0) > RATE_REDESIGN_TOL)
+    return 0;
+  const double k = floor(dt * e->design_rate_hz + 0.5);
+  return k >= 2.0 ? (unsigned)(k - 1.0) : 0;
 }
 
 hm_status hm_estimator_create(const hm_estimator_config *cfg, hm_estimator *out, char *why, size_t why_len) {
@@ -192,9 +249,11 @@ hm_status hm_estimator_create(const hm_estimator_config *cfg, hm_estimator *out,
   e->cross = malloc(e->cross_cap * sizeof(double));
   e->cross_sum = malloc(e->cross_cap * sizeof(double));
   e->cross_count = malloc(e->cross_cap * sizeof(double));
+  e->blk_cap = (size_t)ceil(RATE_BLOCK_S * RATE_BLOCK_MAX_HZ);
+  e->blk_dt = malloc(e->blk_cap * sizeof(double));
   const hm_criteria_config cc = {cfg->rms_window_m,       cfg->rms_limit_mps2,     cfg->peaks_band_low_hz,
                                  cfg->peaks_band_high_hz, cfg->peaks_limit_mps2, cfg->peaks_count};
-  if (!e->cross || !e->cross_sum || !e->cross_count || hm_criteria_create(&cc, &e->criteria) != HM_OK) {
+  if (!e->cross || !e->cross_sum || !e->cross_count || !e->blk_dt || hm_criteria_create(&cc, &e->criteria) != HM_OK) {
     hm_estimator_destroy(e);
     return HM_ENOMEM;
   }
@@ -209,6 +268,7 @@ hm_status hm_estimator_set_limits(hm_estimator e, const hm_estimator_config *cfg
   c.rms_limit_mps2 = cfg->rms_limit_mps2;
   c.peaks_limit_mps2 = cfg->peaks_limit_mps2;
   c.peaks_count = cfg->peaks_count;
+  c.displacement_limit_m = cfg->displacement_limit_m;
   const hm_status st = hm_estimator_config_validate(&c, why, len);
   if (st != HM_OK) return st;
   e->cfg = c;
@@ -227,6 +287,7 @@ void hm_estimator_destroy(hm_estimator e) {
   free(e->cross);
   free(e->cross_sum);
   free(e->cross_count);
+  free(e->blk_dt);
   hm_criteria_destroy(e->criteria);
   free(e);
 }
@@ -235,6 +296,8 @@ void hm_estimator_reset(hm_estimator e) {
   if (!e) return;
   e->design_rate_hz = e->cfg.sample_rate_hz;
   e->measured_rate_hz = 0.0;
+  e->stamps_regular = 0;
+  e->loss_lost = e->loss_got = 0.0;
   restart_signal(e);
   e->have_speed = 0;
   e->speed_kmh = 0.0;
@@ -302,30 +365,8 @@ static double tracked(const hm_estimator e, double *spread, double *amp) {
   return f;
 }
 
-hm_status hm_estimator_push_accel(hm_estimator e, double t, double a) {
-  if (!e) return HM_EINVAL;
-  if (!isfinite(t) || !isfinite(a)) {
-    e->counters.n_rejected_nonfinite++;
-    return HM_EDOMAIN;
-  }
-  if (fabs(a) > e->cfg.max_accel_mps2) {
-    e->counters.n_rejected_range++;
-    return HM_EDOMAIN;
-  }
-  if (e->have_sample && t <= e->t_last) {
-    e->counters.n_rejected_order++;
-    return HM_EDOMAIN; /* bad data, not caller misuse */
-  }
-  if (e->have_sample && t - e->t_last > e->cfg.max_gap_s) {
-    e->counters.n_gaps++;
-    restart_signal(e);
-  }
-  if (e->have_sample) measure_rate(e, t);
-  const double dt = e->have_sample ? t - e->t_last : 1.0 / e->design_rate_hz;
-  if (!e->have_sample) e->t_start = t;
-  e->have_sample = 1;
-  e->t_last = t;
-  e->counters.n_samples++;
+/* One sample on the filters' time grid (dt after the previous one): band-pass, trackers and criteria. */
+static void process(hm_estimator e, double t, double dt, double a) {
   double x = a;
   for (int k = 0; k < BAND_SECTIONS; ++k) x = hm_biquad_step(&e->band[k], x);
   /* mean square with time constant tracking_time / 2 */
@@ -348,8 +389,50 @@ hm_status hm_estimator_push_accel(hm_estimator e, double t, double a) {
   e->x_prev = x;
   const int speed_ok = e->have_speed && t - e->t_speed <= e->cfg.speed_timeout_s;
   hm_criteria_push(e->criteria, x, a, speed_ok ? hm_mps_from_kmh(e->speed_kmh) * dt : 0.0);
+}
+
+hm_status hm_estimator_push_accel(hm_estimator e, double t, double a) {
+  if (!e) return HM_EINVAL;
+  if (!isfinite(t) || !isfinite(a)) {
+    e->counters.n_rejected_nonfinite++;
+    return HM_EDOMAIN;
+  }
+  if (fabs(a) > e->cfg.max_accel_mps2) {
+    e->counters.n_rejected_range++;
+    return HM_EDOMAIN;
+  }
+  if (e->have_sample && t <= e->t_last) {
+    e->counters.n_rejected_order++;
+    return HM_EDOMAIN; /* bad data, not caller misuse */
+  }
+  e->last_fill = 0;
+  if (e->have_sample && t - e->t_last > e->cfg.max_gap_s) {
+    e->counters.n_gaps++;
+    restart_signal(e);
+  }
+  double dt = 1.0 / e->design_rate_hz;
+  if (e->have_sample) {
+    /* lost samples on a regular grid are bridged by linear interpolation, so the filters stay on their time grid */
+    const unsigned lost = lost_before(e, t - e->t_last);
+    dt = (t - e->t_last) / (double)(lost + 1);
+    for (unsigned j = 1; j <= lost; ++j)
+      process(e, e->t_last + j * dt, dt, e->a_prev + (a - e->a_prev) * (double)j / (double)(lost + 1));
+    e->counters.n_samples_lost += lost;
+    e->blk_lost += lost;
+    measure_rate(e, t); /* may redesign and restart the filters */
+    e->last_fill = e->have_sample ? lost : 0;
+  }
+  if (!e->have_sample) e->t_start = t;
+  e->have_sample = 1;
+  e->t_last = t;
+  e->a_prev = a;
+  e->counters.n_samples++;
+  e->blk_got += 1.0;
+  process(e, t, dt, a);
   return HM_OK;
 }
+
+unsigned hm_estimator_last_fill(const hm_estimator e) { return e ? e->last_fill : 0; }
 
 hm_status hm_estimator_push_speed(hm_estimator e, double t, double v) {
   if (!e) return HM_EINVAL;
@@ -380,6 +463,11 @@ void hm_estimator_read(const hm_estimator e, double now, hm_estimate *out) {
   r.sample_rate_measured_hz = e->measured_rate_hz;
   r.sample_rate_mismatch = e->measured_rate_hz > 0.0 && fabs(e->measured_rate_hz / c->sample_rate_hz - 1.0) > RATE_MISMATCH_TOL;
   r.sample_rate_supported = e->measured_rate_hz == 0.0 || rate_supported(c, e->measured_rate_hz);
+  r.stamps_regular = e->stamps_regular;
+  {
+    const double lost = e->loss_lost + e->blk_lost, got = e->loss_got + e->blk_got;
+    r.loss_fraction = lost + got > 0.0 ? lost / (lost + got) : 0.0;
+  }
   r.accel_valid = e->have_sample && isfinite(now) && now - e->t_last <= c->accel_timeout_s && now >= e->t_last - 1.0 &&
                   r.sample_rate_supported;
   r.speed_valid = e->have_speed && isfinite(now) && now - e->t_speed <= c->speed_timeout_s;
@@ -399,5 +487,7 @@ void hm_estimator_read(const hm_estimator e, double now, hm_estimate *out) {
   r.rms_exceeded = k.rms_exceeded;
   r.consecutive_peaks = k.consecutive_peaks;
   r.peaks_exceeded = k.peaks_exceeded;
+  r.displacement_exceeded = c->displacement_limit_m > 0.0 && r.oscillation_valid && r.period_spread <= 0.2 &&
+                            r.amplitude_displacement_m >= c->displacement_limit_m;
   *out = r;
 }

@@ -22,11 +22,18 @@ struct hm_margin_s {
   hm_margin_config cfg;
   hm_vehicle veh;
   hm_linear_coef coef;
+  double lambda0;               /* the vehicle's lambda(0): the model-free line's curvature is taken there */
   window w[HM_MARGIN_MAX_WINDOWS];
   size_t head, n;
   double last_end_s;
   window pending;               /* the current steady stretch, not yet committed */
   int have_pending;
+  double misfit_t[HM_MARGIN_MAX_WINDOWS]; /* end times of misfit windows (ring) */
+  size_t misfit_head, misfit_n;
+  int pending_misfit;           /* the current stretch is a misfit so far */
+  double pending_misfit_t;
+  unsigned long n_changes;
+  double last_change_s;
 };
 
 void hm_margin_config_default(hm_margin_config *c) {
@@ -38,6 +45,8 @@ void hm_margin_config_default(hm_margin_config *c) {
   c->min_speed_span_kmh = 20.0;
   c->max_extrapolation_kmh = 150.0;
   c->interval_z = 2.0;
+  c->max_misfit_chi2 = 9.0;
+  c->change_z = 4.0;
 }
 
 hm_status hm_margin_config_validate(const hm_margin_config *c, char *why, size_t len) {
@@ -52,7 +61,9 @@ hm_status hm_margin_config_validate(const hm_margin_config *c, char *why, size_t
            {"memory_s", c->memory_s, 1.0, 1e6},
            {"min_speed_span_kmh", c->min_speed_span_kmh, 1.0, 1000.0},
            {"max_extrapolation_kmh", c->max_extrapolation_kmh, 1.0, 1000.0},
-           {"interval_z", c->interval_z, 0.5, 10.0}};
+           {"interval_z", c->interval_z, 0.5, 10.0},
+           {"max_misfit_chi2", c->max_misfit_chi2, 1.0, 1e6},
+           {"change_z", c->change_z, 1.0, 100.0}};
   for (size_t i = 0; i < sizeof f / sizeof f[0]; ++i)
     if (!(f[i].v >= f[i].lo && f[i].v <= f[i].hi)) {
       if (why && len) snprintf(why, len, "%s: must be in %g..%g (got %g)", f[i].name, f[i].lo, f[i].hi, f[i].v);
@@ -71,6 +82,7 @@ hm_status hm_margin_create(const hm_margin_config *cfg, const hm_vehicle *veh, h
   m->cfg = *cfg;
   m->veh = *veh;
   hm_linear_coef_from_vehicle(veh, &m->coef);
+  hm_conicity_eval(&veh->conicity, 0.0, &m->lambda0, NULL);
   hm_margin_reset(m);
   *out = m;
   return HM_OK;
@@ -83,6 +95,10 @@ void hm_margin_reset(hm_margin m) {
   m->head = m->n = 0;
   m->last_end_s = -INFINITY;
   m->have_pending = 0;
+  m->misfit_head = m->misfit_n = 0;
+  m->pending_misfit = 0;
+  m->n_changes = 0;
+  m->last_change_s = 0.0;
 }
 
 double hm_margin_hopf_kmh(const hm_margin m, double conicity) {
@@ -99,14 +115,16 @@ static hm_window_verdict prepare(const hm_margin m, double t_end, double speed_k
   if (spread_kmh > c->max_speed_spread_kmh) return HM_WINDOW_SPEED_VARIED;
   if (speed_kmh < c->min_speed_kmh) return HM_WINDOW_TOO_SLOW;
   if (t_end - mode->window_s < m->last_end_s - 1e-9) return HM_WINDOW_OVERLAPS;
-  /* statistical and systematic errors of the measured mode */
-  const double sys_sigma = c->decay_rate_model_error * fabs(mode->decay_rate_1_s);
+  /* statistical and systematic errors of the measured mode (the leakage of a T s window: about 1 / T) */
+  const double sys_sigma = c->decay_rate_model_error * fabs(mode->decay_rate_1_s) + 1.0 / fmax(mode->window_s, 1.0);
   const double sys_f = c->frequency_model_error * mode->frequency_hz;
   const double e_sigma = hypot(mode->decay_rate_se_1_s, sys_sigma), e_f = hypot(mode->frequency_se_hz, sys_f);
   hm_conicity_inversion inv;
   if (hm_conicity_from_mode(&m->coef, speed_kmh, mode->decay_rate_1_s, e_sigma, mode->frequency_hz, e_f, 1e-9, 60,
                             &inv) != HM_OK)
     return HM_WINDOW_NO_INVERSION;
+  w->t_end_s = t_end;
+  if (!(inv.chi2 <= c->max_misfit_chi2)) return HM_WINDOW_MISFIT;
   /* the systematic part of the conicity's error: the weighted sensitivities applied to the systematic errors */
   const double js = inv.dsigma_dconicity / (e_sigma * e_sigma), jf = inv.dfrequency_dconicity / (e_f * e_f);
   const double info = inv.dsigma_dconicity * js + inv.dfrequency_dconicity * jf;
@@ -131,12 +149,55 @@ static void store(hm_margin m, const window *w) {
   m->have_pending = 0;
 }
 
+static void misfit_push(hm_margin m, double t) {
+  m->misfit_t[m->misfit_head] = t;
+  m->misfit_head = (m->misfit_head + 1) % HM_MARGIN_MAX_WINDOWS;
+  if (m->misfit_n < HM_MARGIN_MAX_WINDOWS) ++m->misfit_n;
+}
+
+static void model_based(const hm_margin m, const window *const *ws, size_t n, hm_margin_estimate *r);
+
+/* The windows held (newest first) within memory_s of now; their count. */
+static size_t held(const hm_margin m, double now, const window **ws) {
+  size_t n = 0;
+  for (size_t k = 0; k < m->n; ++k) {
+    const window *w = &m->w[(m->head + HM_MARGIN_MAX_WINDOWS - 1 - k) % HM_MARGIN_MAX_WINDOWS];
+    if (isfinite(now) && now - w->t_end_s > m->cfg.memory_s) continue;
+    ws[n++] = w;
+  }
+  return n;
+}
+
+/* A window whose conicity is more than change_z combined standard errors from the mean of those held: the
+ * conicity changed. Everything held is dropped (the new window too: it may straddle the change). */
+static int changed(hm_margin m, const window *w) {
+  const window *ws[HM_MARGIN_MAX_WINDOWS];
+  const size_t n = held(m, w->t_end_s, ws);
+  hm_margin_estimate r;
+  memset(&r, 0, sizeof r);
+  model_based(m, ws, n, &r);
+  if (!r.conicity_valid || fabs(w->lambda - r.conicity) <= m->cfg.change_z * hypot(w->lambda_se, r.conicity_se))
+    return 0;
+  m->head = m->n = 0;
+  m->have_pending = 0;
+  m->last_end_s = w->t_end_s;
+  m->n_changes++;
+  m->last_change_s = w->t_end_s;
+  return 1;
+}
+
 hm_status hm_margin_add_window(hm_margin m, double t_end, double speed_kmh, double spread_kmh,
                                const hm_mode_estimate *mode, hm_window_verdict *verdict) {
   if (!m || !mode || !verdict || !isfinite(t_end) || !isfinite(speed_kmh) || !isfinite(spread_kmh)) return HM_EINVAL;
   window w;
   *verdict = prepare(m, t_end, speed_kmh, spread_kmh, mode, &w);
+  m->pending_misfit = 0; /* a committed window ends the stretch's provisional one */
+  if (*verdict == HM_WINDOW_MISFIT) misfit_push(m, t_end);
   if (*verdict != HM_WINDOW_USED) return HM_OK;
+  if (changed(m, &w)) {
+    *verdict = HM_WINDOW_CHANGE;
+    return HM_OK;
+  }
   store(m, &w);
   return HM_OK;
 }
@@ -146,13 +207,19 @@ hm_status hm_margin_set_pending(hm_margin m, double t_end, double speed_kmh, dou
   if (!m || !mode || !verdict || !isfinite(t_end) || !isfinite(speed_kmh) || !isfinite(spread_kmh)) return HM_EINVAL;
   window w;
   *verdict = prepare(m, t_end, speed_kmh, spread_kmh, mode, &w);
+  m->pending_misfit = *verdict == HM_WINDOW_MISFIT;
+  m->pending_misfit_t = t_end;
+  if (*verdict == HM_WINDOW_USED && changed(m, &w)) *verdict = HM_WINDOW_CHANGE;
   m->have_pending = *verdict == HM_WINDOW_USED;
   if (m->have_pending) m->pending = w;
   return HM_OK;
 }
 
 void hm_margin_commit_pending(hm_margin m) {
-  if (!m || !m->have_pending) return;
+  if (!m) return;
+  if (m->pending_misfit) misfit_push(m, m->pending_misfit_t);
+  m->pending_misfit = 0;
+  if (!m->have_pending) return;
   store(m, &m->pending);
 }
 
@@ -170,6 +237,17 @@ static void model_based(const hm_margin m, const window *const *ws, size_t n, hm
   r->conicity_valid = 1;
   r->conicity = swl / sw;
   r->conicity_se = hypot(sqrt(sw2stat) / sw, swsys / sw);
+  /* windows that disagree more than their errors say widen the interval (the Birge ratio) */
+  r->birge_ratio = 1.0;
+  if (n > 1) {
+    double chi2 = 0.0;
+    for (size_t k = 0; k < n; ++k) {
+      const double d = (ws[k]->lambda - r->conicity) / ws[k]->lambda_se;
+      chi2 += d * d;
+    }
+    r->birge_ratio = sqrt(chi2 / (double)(n - 1));
+    if (r->birge_ratio > 1.0) r->conicity_se *= r->birge_ratio;
+  }
   const double z = m->cfg.interval_z;
   r->hopf_model_valid = 1;
   r->hopf_model_kmh = hm_margin_hopf_kmh(m, r->conicity);
@@ -179,7 +257,43 @@ static void model_based(const hm_margin m, const window *const *ws, size_t n, hm
   r->hopf_model_high_kmh = hm_margin_hopf_kmh(m, r->conicity_low);
 }
 
-/* (b): weighted least squares of sigma on x = 1000 / v; the zero of the line with a delta-method interval. */
+/* P(|T| <= t) for Student's t with nu degrees of freedom (Abramowitz & Stegun 26.7.3-4: finite sums in theta). */
+static double student_t_central(double t, unsigned nu) {
+  const double th = atan(t / sqrt((double)nu)), c = cos(th), s = sin(th);
+  double sum = 0.0, term;
+  if (nu % 2 == 1) {
+    if (nu == 1) return 2.0 * th / HM_PI;
+    term = c;
+    sum = c;
+    for (unsigned k = 3; k + 2 <= nu; k += 2) sum += (term *= c * c * (double)(k - 1) / (double)k);
+    return 2.0 / HM_PI * (th + s * sum);
+  }
+  term = 1.0;
+  sum = 1.0;
+  for (unsigned k = 2; k + 2 <= nu; k += 2) sum += (term *= c * c * (double)(k - 1) / (double)k);
+  return s * sum;
+}
+
+/* The t quantile with the two-sided coverage of +-z standard normal deviations, by bisection. */
+static double student_t_for_z(double z, unsigned nu) {
+  const double p = erf(z / sqrt(2.0));
+  double lo = z, hi = 1e4;
+  for (int it = 0; it < 200 && hi - lo > 1e-10 * hi; ++it) {
+    const double mid = 0.5 * (lo + hi);
+    if (student_t_central(mid, nu) < p) lo = mid;
+    else hi = mid;
+  }
+  return 0.5 * (lo + hi);
+}
+
+/* The model's decay rate [1/s] at x = 1000 / v (v in km/h) and the vehicle's lambda(0); NAN if it cannot be found. */
+static double model_sigma(const hm_margin m, double x) {
+  double sg, om;
+  return hm_hunting_root(&m->coef, 1000.0 / x, m->lambda0, &sg, &om) == HM_OK ? sg : NAN;
+}
+
+/* (b): weighted least squares of sigma on x = 1000 / v; the zero of the line with Fieller's interval, widened by the
+ * line's curvature error. */
 static void model_free(const hm_margin m, const window *const *ws, size_t n, hm_margin_estimate *r) {
   const hm_margin_config *c = &m->cfg;
   if (n < 2 || r->speed_max_kmh - r->speed_min_kmh < c->min_speed_span_kmh) return;
@@ -192,27 +306,40 @@ static void model_free(const hm_margin m, const window *const *ws, size_t n, hm_
   if (!(det > 0.0)) return;
   const double beta = (s0 * t1 - s1 * t0) / det, alpha = (s2 * t0 - s1 * t1) / det;
   double var_a = s2 / det, var_b = s0 / det, cov_ab = -s1 / det;
+  double q = c->interval_z; /* the stated errors: normal quantiles */
   if (n > 2) { /* scale by the residual variance when there are degrees of freedom (never below the stated errors) */
     double chi2 = 0.0;
     for (size_t k = 0; k < n; ++k) {
       const double d = (ws[k]->sigma - alpha - beta * 1000.0 / ws[k]->speed_kmh) / ws[k]->sigma_stat;
       chi2 += d * d;
     }
-    const double f = fmax(1.0, chi2 / (double)(n - 2));
-    var_a *= f, var_b *= f, cov_ab *= f;
+    const double f = chi2 / (double)(n - 2);
+    if (f > 1.0) { /* the errors estimated from the residuals: Student's t with n - 2 degrees of freedom */
+      var_a *= f, var_b *= f, cov_ab *= f;
+      q = student_t_for_z(c->interval_z, (unsigned)(n - 2));
+    }
   }
-  const double z = c->interval_z;
-  if (!(beta + z * sqrt(var_b) < 0.0)) return; /* no significant approach to zero with speed */
+  /* Fieller: the x where |alpha + beta x| <= q sd(alpha + beta x), a x^2 + b x + cc <= 0 */
+  const double qq = q * q, a = beta * beta - qq * var_b, b = 2.0 * (alpha * beta - qq * cov_ab);
+  const double cc = alpha * alpha - qq * var_a, disc = b * b - 4.0 * a * cc;
+  if (!(beta < 0.0) || !(a > 0.0) || !(disc >= 0.0)) return; /* no significant approach to zero with speed */
   const double xh = -alpha / beta;
-  /* d xh / d alpha = -1/beta, d xh / d beta = alpha / beta^2 */
-  const double var_x = (var_a + xh * xh * var_b + 2.0 * xh * cov_ab) / (beta * beta);
-  if (!(xh > 0.0) || !isfinite(var_x)) return;
-  const double se_x = sqrt(var_x), vh = 1000.0 / xh;
+  double x1 = (-b - sqrt(disc)) / (2.0 * a), x2 = (-b + sqrt(disc)) / (2.0 * a);
+  if (!(xh > 0.0) || !isfinite(x1) || !isfinite(x2)) return;
+  /* the line's own error: the model's sigma(x) against its chord through the windows' speeds, at the zero */
+  const double xa = 1000.0 / r->speed_max_kmh, xb = 1000.0 / r->speed_min_kmh;
+  const double sa = model_sigma(m, xa), sb = model_sigma(m, xb), sh = model_sigma(m, xh);
+  if (isfinite(sa) && isfinite(sb) && isfinite(sh) && xb > xa) {
+    const double gap = sh - (sa + (sb - sa) * (xh - xa) / (xb - xa)), dx = fabs(gap / beta);
+    x1 -= dx;
+    x2 += dx;
+  }
+  const double vh = 1000.0 / xh;
   if (vh > r->speed_max_kmh + c->max_extrapolation_kmh) return;
   r->hopf_free_valid = 1;
   r->hopf_free_kmh = vh;
-  r->hopf_free_low_kmh = 1000.0 / (xh + z * se_x);
-  r->hopf_free_high_kmh = xh - z * se_x > 1000.0 / NO_HOPF_KMH ? 1000.0 / (xh - z * se_x) : NO_HOPF_KMH;
+  r->hopf_free_low_kmh = 1000.0 / x2;
+  r->hopf_free_high_kmh = x1 > 1000.0 / NO_HOPF_KMH ? 1000.0 / x1 : NO_HOPF_KMH;
 }
 
 void hm_margin_read(const hm_margin m, double now, hm_margin_estimate *out) {
@@ -220,15 +347,12 @@ void hm_margin_read(const hm_margin m, double now, hm_margin_estimate *out) {
   hm_margin_estimate r;
   memset(&r, 0, sizeof r);
   const window *ws[HM_MARGIN_MAX_WINDOWS];
-  size_t n = 0;
+  size_t n = held(m, now, ws);
   r.speed_min_kmh = INFINITY;
   r.speed_max_kmh = -INFINITY;
-  for (size_t k = 0; k < m->n; ++k) {
-    const window *w = &m->w[(m->head + HM_MARGIN_MAX_WINDOWS - 1 - k) % HM_MARGIN_MAX_WINDOWS];
-    if (isfinite(now) && now - w->t_end_s > m->cfg.memory_s) continue;
-    ws[n++] = w;
-    r.speed_min_kmh = fmin(r.speed_min_kmh, w->speed_kmh);
-    r.speed_max_kmh = fmax(r.speed_max_kmh, w->speed_kmh);
+  for (size_t k = 0; k < n; ++k) {
+    r.speed_min_kmh = fmin(r.speed_min_kmh, ws[k]->speed_kmh);
+    r.speed_max_kmh = fmax(r.speed_max_kmh, ws[k]->speed_kmh);
   }
   if (m->have_pending && n < HM_MARGIN_MAX_WINDOWS) { /* the current stretch counts, provisionally */
     ws[n++] = &m->pending;
@@ -237,9 +361,16 @@ void hm_margin_read(const hm_margin m, double now, hm_margin_estimate *out) {
   }
   r.n_windows = (unsigned)n;
   if (n == 0) r.speed_min_kmh = r.speed_max_kmh = 0.0;
+  r.birge_ratio = 1.0;
   model_based(m, ws, n, &r);
   model_free(m, ws, n, &r);
-  r.model_mismatch = r.hopf_model_valid && r.hopf_free_valid &&
-                     (r.hopf_model_high_kmh < r.hopf_free_low_kmh || r.hopf_free_high_kmh < r.hopf_model_low_kmh);
+  for (size_t k = 0; k < m->misfit_n; ++k)
+    r.n_misfits += !(isfinite(now) && now - m->misfit_t[k] > m->cfg.memory_s);
+  r.n_misfits += (unsigned)m->pending_misfit;
+  r.n_changes = m->n_changes;
+  r.last_change_s = m->last_change_s;
+  r.model_mismatch = (r.hopf_model_valid && r.hopf_free_valid &&
+                      (r.hopf_model_high_kmh < r.hopf_free_low_kmh || r.hopf_free_high_kmh < r.hopf_model_low_kmh)) ||
+                     r.n_misfits >= 2;
   *out = r;
 }

@@ -8,6 +8,7 @@
 
 #include "biquad.h"
 #include "fft.h"
+#include "hunting_monitor/lines.h"
 
 enum { NP = 7 }; /* sigma, w0, c0, c1, c2, c3, ln N */
 enum { P_SIGMA, P_W0, P_C0, P_C1, P_C2, P_C3, P_LN };
@@ -22,6 +23,9 @@ struct hm_modal_s {
   size_t nfft_max, nfft;
   double *re, *im, *cosw, *sinw; /* FFT work and twiddles (nfft_max / 2) */
   double *w, *pgram, *u;       /* band bins: angular frequency, periodogram, ln(w / w_ref) */
+  double *power;               /* |X_k|^2 of every bin (the line search) */
+  unsigned char *excluded;     /* the bins of a comb of lines */
+  hm_lines lines;
   double theta[NP];
   int have_theta;
 };
@@ -35,6 +39,22 @@ void hm_modal_config_default(hm_modal_config *c) {
   c->fit_interval_s = 1.0;
   c->tol = 1e-10;
   c->max_iter = 80;
+  hm_lines_config lc;
+  hm_lines_config_default(&lc);
+  c->reject_lines = 1;
+  c->line_candidate_ratio = lc.candidate_ratio;
+  c->line_min_fundamental_hz = lc.min_fundamental_hz;
+  c->line_min_harmonics = lc.min_harmonics;
+}
+
+/* The line search's settings from the identification's. */
+static hm_lines_config lines_config(const hm_modal_config *c) {
+  hm_lines_config lc;
+  hm_lines_config_default(&lc);
+  lc.candidate_ratio = c->line_candidate_ratio;
+  lc.min_fundamental_hz = c->line_min_fundamental_hz;
+  lc.min_harmonics = c->line_min_harmonics;
+  return lc;
 }
 
 static hm_status bad(char *why, size_t len, const char *field, const char *reason, double got) {
@@ -57,6 +77,13 @@ hm_status hm_modal_config_validate(const hm_modal_config *c, char *why, size_t l
     return bad(why, len, "fit_interval_s", "must be in 0.01..window_s", c->fit_interval_s);
   if (!(c->tol > 0.0 && c->tol < 1e-2)) return bad(why, len, "tol", "must be in (0, 0.01)", c->tol);
   if (c->max_iter < 1 || c->max_iter > 10000) return bad(why, len, "max_iter", "must be 1..10000", c->max_iter);
+  if (c->reject_lines != 0 && c->reject_lines != 1) return bad(why, len, "reject_lines", "must be 0 or 1", c->reject_lines);
+  const hm_lines_config lc = lines_config(c);
+  char tmp[160] = "";
+  if (hm_lines_config_validate(&lc, tmp, sizeof tmp) != HM_OK) {
+    if (why && len) snprintf(why, len, "line_%s", tmp);
+    return HM_EDOMAIN;
+  }
   return HM_OK;
 }
 
@@ -108,7 +135,11 @@ hm_status hm_modal_create(const hm_modal_config *cfg, double fs, hm_modal *out, 
   m->w = malloc((m->nfft_max / 2 + 1) * sizeof(double));
   m->pgram = malloc((m->nfft_max / 2 + 1) * sizeof(double));
   m->u = malloc((m->nfft_max / 2 + 1) * sizeof(double));
-  if (!m->ring || !m->re || !m->im || !m->cosw || !m->sinw || !m->w || !m->pgram || !m->u) {
+  m->power = malloc((m->nfft_max / 2 + 1) * sizeof(double));
+  m->excluded = malloc(m->nfft_max / 2 + 1);
+  const hm_lines_config lc = lines_config(cfg);
+  if (!m->ring || !m->re || !m->im || !m->cosw || !m->sinw || !m->w || !m->pgram || !m->u || !m->power ||
+      !m->excluded || hm_lines_create(&lc, m->nfft_max / 2 + 1, &m->lines, NULL, 0) != HM_OK) {
     hm_modal_destroy(m);
     return HM_ENOMEM;
   }
@@ -128,6 +159,9 @@ void hm_modal_destroy(hm_modal m) {
   free(m->w);
   free(m->pgram);
   free(m->u);
+  free(m->power);
+  free(m->excluded);
+  hm_lines_destroy(m->lines);
   free(m);
 }
 
@@ -162,8 +196,11 @@ void hm_modal_push(hm_modal m, double a) {
   ++m->since_fit;
 }
 
+/* Decimated samples in min_window_s (as many as arrive in it: rounded down). */
+static size_t min_samples(const hm_modal m) { return (size_t)floor(m->cfg.min_window_s * m->fd + 1e-6); }
+
 int hm_modal_fit_due(const hm_modal m) {
-  return m && (double)m->n_in >= m->cfg.min_window_s * m->fd && (double)m->since_fit >= m->cfg.fit_interval_s * m->fd;
+  return m && m->n_in >= min_samples(m) && (double)m->since_fit >= m->cfg.fit_interval_s * m->fd;
 }
 
 /* S_k (its gradient of ln S_k in grad, if not NULL) for bin k. */
@@ -304,9 +341,9 @@ hm_status hm_modal_fit(hm_modal m, double max_window_s, hm_mode_estimate *out) {
   m->since_fit = 0;
   hm_mode_estimate r;
   memset(&r, 0, sizeof r);
-  const size_t n = (size_t)fmin((double)m->n_in, floor(max_window_s * m->fd + 1e-9));
+  const size_t n = (size_t)fmin((double)m->n_in, floor(max_window_s * m->fd + 1e-6));
   r.window_s = (double)n / m->fd;
-  if ((double)n < m->cfg.min_window_s * m->fd - 1e-9) {
+  if (n < min_samples(m)) {
     *out = r;
     return HM_OK;
   }
@@ -320,16 +357,33 @@ hm_status hm_modal_fit(hm_modal m, double max_window_s, hm_mode_estimate *out) {
     m->im[k] = 0.0;
   }
   hm_fft(m->re, m->im, m->nfft, m->cosw, m->sinw, m->nfft_max);
-  /* the band's bins, the periodogram scaled to mean 1 (the fit is scale-free; it keeps exp() in range) */
   const double df = m->fd / (double)m->nfft, w_ref = 2.0 * HM_PI * 0.5 * (m->cfg.band_low_hz + m->cfg.band_high_hz);
-  size_t nb = 0;
+  /* a comb of lines (a periodic excitation of the track) over the decimated signal's band */
+  const size_t nbins = m->nfft / 2 + 1;
+  for (size_t k = 0; k < nbins; ++k) m->power[k] = m->re[k] * m->re[k] + m->im[k] * m->im[k];
+  hm_lines_result lr;
+  if (hm_lines_find(m->lines, m->power, nbins, df, r.window_s, 2.5, 0.3 * m->fd, m->excluded, &lr) != HM_OK)
+    memset(&lr, 0, sizeof lr);
+  const int drop = m->cfg.reject_lines && lr.found;
+  r.lines_found = lr.found;
+  r.line_fundamental_hz = lr.fundamental_hz;
+  r.line_harmonics = lr.harmonics;
+  r.line_strongest_hz = lr.strongest_hz;
+  /* a sinusoid of amplitude A over n samples has |X| = A n / 2 at its bin */
+  r.line_strongest_mps2 = lr.found ? 2.0 * sqrt(m->power[lr.strongest_bin]) / (double)n : 0.0;
+  /* the band's bins (less a comb's), the periodogram scaled to mean 1 (the fit is scale-free; it keeps exp() in
+   * range) */
+  size_t nb = 0, n_band = 0;
   double scale = 0.0;
   for (size_t k = (size_t)ceil(m->cfg.band_low_hz / df); (double)k * df <= m->cfg.band_high_hz && k <= m->nfft / 2; ++k) {
+    ++n_band;
+    if (drop && m->excluded[k]) continue;
     m->w[nb] = 2.0 * HM_PI * (double)k * df;
     m->u[nb] = log(m->w[nb] / w_ref);
     m->pgram[nb] = m->re[k] * m->re[k] + m->im[k] * m->im[k];
     scale += m->pgram[nb++];
   }
+  r.band_excluded_fraction = n_band ? 1.0 - (double)nb / (double)n_band : 0.0;
   scale /= (double)nb;
   if (!(scale > 0.0) || nb < 4 * NP) {
     *out = r;
@@ -363,14 +417,15 @@ hm_status hm_modal_fit(hm_modal m, double max_window_s, hm_mode_estimate *out) {
   }
   memcpy(m->theta, best, sizeof best);
   m->have_theta = 1;
-  /* standard errors from Whittle's covariance (J'J)^-1 */
+  /* standard errors from Whittle's covariance (J'J)^-1, for the n independent ordinates of nfft padded ones */
   double f[NP][NP], g[NP], var[NP];
   scoring_system(m, nb, best, f, g);
+  const double padding = (double)m->nfft / (double)n;
   for (int i = 0; i < NP; ++i) {
     double a[NP][NP], e[NP] = {0};
     memcpy(a, f, sizeof a);
     e[i] = 1.0;
-    var[i] = chol_solve(a, e) ? e[i] : INFINITY;
+    var[i] = chol_solve(a, e) ? e[i] * padding : INFINITY;
   }
   const double sg = -fabs(best[P_SIGMA]), w0 = fabs(best[P_W0]), mag = sqrt(sg * sg + w0 * w0);
   r.frequency_hz = w0 / (2.0 * HM_PI);

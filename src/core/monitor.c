@@ -1,6 +1,8 @@
 /* The online monitor: estimator + identification + margin + alarm + table, and the start-up policy (monitor.h). */
 #include "hunting_monitor/monitor.h"
 
+#include "hunting_monitor/linear.h"
+
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -34,6 +36,7 @@ struct hm_monitor_s {
   double committed_until;        /* end of the last window committed to the margin (or the stream's restart) */
   double conicity_in_use;        /* of the latest update that had data; NAN before */
   double refine_failed_at;       /* the conicity whose exact family could not be computed; NAN if none */
+  double a_prev;                 /* the previous accepted acceleration sample (bridging lost samples) */
 };
 
 void hm_monitor_config_default(hm_monitor_config *c) {
@@ -130,6 +133,7 @@ hm_status hm_monitor_create_parallel(const hm_monitor_config *cfg, const hm_vehi
     hm_monitor_destroy(m);
     return st;
   }
+  hm_alarm_set_displacement_limit(m->alarm, cfg->estimator.displacement_limit_m);
   m->modal_ok = 1;
   m->conicity_in_use = NAN;
   m->refine_failed_at = NAN;
@@ -208,6 +212,7 @@ static void fit(hm_monitor m, double t) {
   } else {
     hm_margin_set_pending(m->margin, t, m->mode_speed, m->mode_spread, &e, &m->verdict);
   }
+  if (m->verdict == HM_WINDOW_CHANGE) m->committed_until = t; /* the next window starts after the change */
 }
 
 hm_status hm_monitor_push_accel(hm_monitor m, double t, double a) {
@@ -233,7 +238,12 @@ hm_status hm_monitor_push_accel(hm_monitor m, double t, double a) {
     m->cur.sum += m->speed_kmh;
     m->cur.n += 1.0;
   }
+  const double a_prev = m->a_prev;
+  m->a_prev = a;
   if (!m->modal_ok) return HM_OK;
+  /* the samples the estimator bridged (lost on a regular grid), interpolated as it did */
+  const unsigned fill = hm_estimator_last_fill(m->est);
+  for (unsigned j = 1; j <= fill; ++j) hm_modal_push(m->modal, a_prev + (a - a_prev) * (double)j / (double)(fill + 1));
   hm_modal_push(m->modal, a);
   if (hm_modal_fit_due(m->modal)) fit(m, t);
   return HM_OK;
@@ -263,6 +273,9 @@ hm_status hm_monitor_update(hm_monitor m, double now, hm_monitor_status *out) {
   s.mode_speed_kmh = m->mode_speed;
   s.mode_speed_spread_kmh = isfinite(m->mode_spread) ? m->mode_spread : -1.0;
   s.mode_verdict = m->verdict;
+  s.line_wavelength_m = m->mode.lines_found && m->mode.line_fundamental_hz > 0.0
+                            ? hm_mps_from_kmh(m->mode_speed) / m->mode.line_fundamental_hz
+                            : 0.0;
   *out = s;
   return HM_OK;
 }
@@ -276,11 +289,13 @@ hm_status hm_monitor_set_runtime_settings(hm_monitor m, const hm_monitor_config 
   c.estimator.rms_limit_mps2 = cfg->estimator.rms_limit_mps2;
   c.estimator.peaks_limit_mps2 = cfg->estimator.peaks_limit_mps2;
   c.estimator.peaks_count = cfg->estimator.peaks_count;
+  c.estimator.displacement_limit_m = cfg->estimator.displacement_limit_m;
   hm_status st = hm_monitor_config_validate(&c, why, len);
   if (st != HM_OK) return st;
   /* both parts were validated above, so neither setter can fail half-way */
   if ((st = hm_estimator_set_limits(m->est, &c.estimator, why, len)) != HM_OK) return st;
   if ((st = hm_alarm_set_config(m->alarm, &c.alarm, &m->veh, why, len)) != HM_OK) return st;
+  hm_alarm_set_displacement_limit(m->alarm, c.estimator.displacement_limit_m);
   m->cfg = c;
   return HM_OK;
 }

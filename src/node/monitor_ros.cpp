@@ -17,6 +17,8 @@ extern "C" {
 namespace hunting_monitor {
 
 namespace {
+// The inputs diagnostic warns when more than this fraction of the samples was lost over the last 10 s.
+constexpr double kLossWarnFraction = 0.01;
 // A NaN never goes out: unknown quantities are 0 with their *_valid flag false.
 double finite(double x) { return std::isfinite(x) ? x : 0.0; }
 }  // namespace
@@ -277,10 +279,14 @@ void MonitorRos::onTimer(const ros::TimerEvent&) {
   m.level = static_cast<uint8_t>(s.level);
   m.reason_code = static_cast<uint8_t>(s.reason);
   m.reason = hm_reason_text(s.reason);
+  m.level_latched = s.latched;
+  m.latch_release_in_s = s.latched ? finite(s.release_in_s) : 0.0;
   m.speed_kmh = finite(e.speed_kmh);
   m.speed_valid = e.speed_valid;
   m.sample_rate_hz = finite(e.sample_rate_measured_hz);
   m.sample_rate_mismatch = e.sample_rate_mismatch;
+  m.samples_lost = e.n_samples_lost;
+  m.samples_lost_fraction = finite(e.loss_fraction);
   m.mode_valid = md.valid;
   m.mode_frequency_hz = md.valid ? finite(md.frequency_hz) : 0.0;
   m.mode_frequency_se_hz = md.valid ? finite(md.frequency_se_hz) : 0.0;
@@ -289,6 +295,11 @@ void MonitorRos::onTimer(const ros::TimerEvent&) {
   m.damping_ratio = md.valid ? finite(md.damping_ratio) : 0.0;
   m.damping_ratio_se = md.valid ? finite(md.damping_ratio_se) : 0.0;
   m.windows_used = g.n_windows;
+  m.track_lines_found = md.lines_found;
+  m.track_line_wavelength_m = md.lines_found ? finite(st.line_wavelength_m) : 0.0;
+  m.track_line_spacing_hz = md.lines_found ? finite(md.line_fundamental_hz) : 0.0;
+  m.track_line_strongest_hz = md.lines_found ? finite(md.line_strongest_hz) : 0.0;
+  m.track_line_strongest_mps2 = md.lines_found ? finite(md.line_strongest_mps2) : 0.0;
   m.conicity_valid = g.conicity_valid;
   m.conicity_estimate = g.conicity_valid ? finite(g.conicity) : 0.0;
   m.conicity_se = g.conicity_valid ? finite(g.conicity_se) : 0.0;
@@ -301,10 +312,22 @@ void MonitorRos::onTimer(const ros::TimerEvent&) {
   m.hopf_free_kmh_low = g.hopf_free_valid ? finite(g.hopf_free_low_kmh) : 0.0;
   m.hopf_free_kmh_high = g.hopf_free_valid ? finite(g.hopf_free_high_kmh) : 0.0;
   m.model_mismatch = g.model_mismatch;
+  m.windows_birge_ratio = finite(g.birge_ratio);
+  m.misfit_windows = g.n_misfits;
+  m.conicity_changes = static_cast<uint32_t>(g.n_changes);
+  if (g.n_changes > 0) m.last_conicity_change = ros::Time(g.last_change_s);
+  if (g.n_changes != last_changes_) {
+    if (g.n_changes > last_changes_)
+      ROS_WARN("hunting_monitor: the conicity changed (a window %.0f s ago disagreed with those held): the "
+               "identification starts again from the next window, the prior's interval meanwhile",
+               now.toSec() - g.last_change_s);
+    last_changes_ = g.n_changes;
+  }
   m.boundaries_valid = s.boundaries_valid;  // never a stale margin presented as current
   const hm_table_lookup_result& b = s.boundaries;
   m.conicity_used = s.boundaries_valid ? finite(s.conicity) : 0.0;
   m.conicity_from_estimate = s.boundaries_valid && s.conicity_from_estimate;
+  m.conicity_from_prior = s.boundaries_valid && s.conicity_from_prior;
   m.hopf_speed_kmh = s.boundaries_valid ? finite(b.hopf_speed_kmh) : 0.0;
   m.hopf_speed_kmh_low = s.boundaries_valid ? finite(s.hopf_low_kmh) : 0.0;
   m.hopf_speed_kmh_high = s.boundaries_valid ? finite(s.hopf_high_kmh) : 0.0;
@@ -329,6 +352,7 @@ void MonitorRos::onTimer(const ros::TimerEvent&) {
   m.consecutive_peaks = e.consecutive_peaks;
   m.criterion_rms_exceeded = e.rms_exceeded;
   m.criterion_peaks_exceeded = e.peaks_exceeded;
+  m.criterion_displacement_exceeded = e.displacement_exceeded;
   status_pub_.publish(m);
 
   if (static_cast<int>(s.level) != last_published_level_) {
@@ -381,7 +405,7 @@ void MonitorRos::publishMarkers(const hm_monitor_status& st, const ros::Time& no
                   s.hopf_low_kmh, s.hopf_high_kmh, hopfMarginWords(s.margin_hopf_kmh).c_str(),
                   s.boundaries.lowest_cycle_speed_kmh,
                   1e3 * e.amplitude_displacement_m, e.frequency_hz, 1e3 * s.edge_used_m, s.conicity,
-                  s.conicity_from_estimate ? "identified" : "configured", decay);
+                  s.conicity_from_estimate ? "identified" : "prior", decay);
   else
     std::snprintf(buf, sizeof buf, "%s: %s", hm_level_name(s.level), hm_reason_text(s.reason));
   text.text = buf;
@@ -404,7 +428,12 @@ void MonitorRos::diagnoseInputs(diagnostic_updater::DiagnosticStatusWrapper& sta
                  "acceleration at " + std::to_string(static_cast<int>(std::lround(e.sample_rate_measured_hz))) +
                      " Hz, configured " + std::to_string(static_cast<int>(std::lround(cfg_.estimator.sample_rate_hz))) +
                      " Hz: filters follow the measured rate");
-  else if (e.n_rejected_nonfinite + e.n_rejected_range + e.n_rejected_order + e.n_speed_rejected + e.n_gaps > 0)
+  else if (e.loss_fraction > kLossWarnFraction) {
+    char text[128];
+    std::snprintf(text, sizeof text, "%.1f%% of the acceleration samples lost over the last 10 s (bridged)",
+                  100.0 * e.loss_fraction);
+    stat.summary(diagnostic_msgs::DiagnosticStatus::WARN, text);
+  } else if (e.n_rejected_nonfinite + e.n_rejected_range + e.n_rejected_order + e.n_speed_rejected + e.n_gaps > 0)
     stat.summary(diagnostic_msgs::DiagnosticStatus::WARN, "inputs current; some samples were rejected");
   else
     stat.summary(diagnostic_msgs::DiagnosticStatus::OK, "inputs current");
@@ -416,6 +445,9 @@ void MonitorRos::diagnoseInputs(diagnostic_updater::DiagnosticStatusWrapper& sta
   stat.add("rejected out of range", e.n_rejected_range);
   stat.add("rejected out of order", e.n_rejected_order);
   stat.add("gaps", e.n_gaps);
+  stat.add("samples lost", e.n_samples_lost);
+  stat.add("samples lost over the last 10 s [%]", 100.0 * e.loss_fraction);
+  stat.add("stamps on a regular grid", static_cast<bool>(e.stamps_regular));
   stat.add("rejected speeds", e.n_speed_rejected);
   stat.add("time jumps", time_jumps_);
   stat.add("last time jump", last_jump_.empty() ? std::string("none") : last_jump_);
@@ -429,7 +461,9 @@ void MonitorRos::diagnoseLevel(diagnostic_updater::DiagnosticStatusWrapper& stat
   const unsigned char d = l == HM_LEVEL_OK || l == HM_LEVEL_WATCH ? diagnostic_msgs::DiagnosticStatus::OK
                           : l == HM_LEVEL_WARN                       ? diagnostic_msgs::DiagnosticStatus::WARN
                                                                      : diagnostic_msgs::DiagnosticStatus::ERROR;
-  stat.summary(d, std::string(hm_level_name(l)) + ": " + hm_reason_text(have_last_ ? s.reason : HM_REASON_STARTUP));
+  stat.summary(d, std::string(hm_level_name(l)) + ": " + hm_reason_text(have_last_ ? s.reason : HM_REASON_STARTUP) +
+                     (have_last_ && s.latched ? " (held until the oscillation stays calm and the speed drops)" : ""));
+  if (have_last_ && s.latched) stat.add("latched: calm still needed [s]", s.release_in_s);
   if (have_last_ && s.boundaries_valid) {
     stat.add("margin to Hopf [km/h]", s.margin_hopf_kmh);
     stat.add("Hopf interval low [km/h]", s.hopf_low_kmh);
@@ -446,7 +480,19 @@ void MonitorRos::diagnoseLevel(diagnostic_updater::DiagnosticStatusWrapper& stat
       stat.add("damping ratio", last_.mode.damping_ratio);
     }
     if (g.hopf_free_valid) stat.add("model-free Hopf [km/h]", g.hopf_free_kmh);
+    if (last_.mode.lines_found) {
+      char text[160];
+      std::snprintf(text, sizeof text, "every %.1f m (lines every %.2f Hz, strongest %.2f Hz at %.3f m/s^2): left out",
+                    last_.line_wavelength_m, last_.mode.line_fundamental_hz, last_.mode.line_strongest_hz,
+                    last_.mode.line_strongest_mps2);
+      stat.add("periodic track excitation", std::string(text));
+    } else {
+      stat.add("periodic track excitation", std::string("none found"));
+    }
     stat.add("model mismatch", static_cast<bool>(g.model_mismatch));
+    stat.add("misfit windows", g.n_misfits);
+    stat.add("windows' Birge ratio", g.birge_ratio);
+    stat.add("conicity changes detected", g.n_changes);
   }
 }
 

@@ -66,6 +66,7 @@ class MonitorRos {
   hm_monitor_status last_{};
   bool have_last_ = false;
   int last_published_level_ = -1;
+  unsigned long last_changes_ = 0;  // conicity changes the margin had detected at the last status (logged once each)
   // the table's refinement (the core says where, the worker computes, the callbacks never wait)
   std::unique_ptr<TableRefiner> refiner_;
   unsigned long refinements_ = 0, refinement_failures_ = 0;

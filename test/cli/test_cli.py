@@ -349,10 +349,12 @@ def lines(text):
 
 
 def test_simulate_streams_and_estimate_ramp_through_hopf():
-    # A speed ramp 480 -> 530 km/h over 30 s through the Hopf speed (517.6 km/h) on a smooth irregular track:
-    # the monitor says OK first (480 km/h is in the bistable band, which is stated in the fields, not as a level),
-    # WATCH from 30 km/h below the Hopf interval (517.618 -+ the table's stated error), WARN from 10 km/h below it,
-    # ALARM at the latest once the Hopf speed is passed, and never shows margins without data.
+    # A speed ramp 480 -> 530 km/h over 30 s through the Hopf speed (517.6 km/h) on a smooth irregular track, for a
+    # vehicle whose conicity is known (a prior range of 0.1358 -+ 1e-5): the monitor says OK first (480 km/h is in
+    # the bistable band, which is stated in the fields, not as a level), WATCH from 30 km/h below the Hopf interval
+    # (517.618 -+ the table's stated error), WARN from 10 km/h below it, ALARM at the latest once the Hopf speed is
+    # passed, and never shows margins without data. With the default prior (0.1358 -+ 0.03) the same run is WARN
+    # from the start: the interval's lower end is the closed-form Hopf speed at 0.1658 (`hunting critical`).
     with tempfile.TemporaryDirectory() as d:
         acc, spd, tbl = (os.path.join(d, n) for n in ("a.csv", "s.csv", "t.tbl"))
         run("simulate", "--v", "480", "--v-end", "530", "--t", "30", "--irregularity", "0.01", "--dt-out", "0.0005",
@@ -361,7 +363,16 @@ def test_simulate_streams_and_estimate_ramp_through_hopf():
             head = [next(f) for _ in range(3)]
         assert head[0].strip() == "t_s,accel_mps2" and len(open(acc).readlines()) == 60002, head
         run("tables", "--out", tbl, "--conicity-min", "0.12", "--conicity-max", "0.16", "--n", "3")
-        out = lines(run("estimate", "--accel", acc, "--speed", spd, "--table", tbl, "--every", "0.5").stdout)
+        known = os.path.join(d, "known.yaml")
+        with open(known, "w") as f:
+            f.write("alarm:\n  conicity_prior_low: 0.13579\n  conicity_prior_high: 0.13581\n")
+        out = lines(run("estimate", "--accel", acc, "--speed", spd, "--table", tbl, "--every", "0.5",
+                        "--monitor", known).stdout)
+        prior = lines(run("estimate", "--accel", acc, "--speed", spd, "--table", tbl, "--every", "0.5").stdout)
+    worn_hopf = json.loads(run("critical", "--conicity", "0.1658").stdout)["v_crit_kmh"]
+    first = next(o for o in prior if o["level"] != "NO_DATA")
+    assert first["level"] == "WARN" and first["reason_code"] == 5 and not first["conicity_from_estimate"], first
+    close(first["hopf_kmh_low"], worn_hopf, 0.01, "the prior's lower end")
     assert len(out) >= 55, len(out)
     levels = [o["level"] for o in out]
     assert levels[1] == "OK" and out[1]["margin_lowest_cycle_kmh"] < 0, levels

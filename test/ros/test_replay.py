@@ -103,15 +103,22 @@ class Replay(unittest.TestCase):
         seq = self.data_statuses()
         levels = [LEVELS[m.level] for m in seq]
         self.assertNotIn("NO_DATA", levels, "NO_DATA while data flows")
-        # OK in the bistable band too (from 239.5 km/h, MODEL.md section 7: stated in the fields, not as a level),
-        # WATCH from 30 km/h below the Hopf interval (517.618 km/h -+ the shipped table's stated 0.48 km/h), WARN
-        # from 10 km/h below it, ALARM at the latest just past the Hopf speed; the levels only go up along the ramp
+        # OK in the bistable band too (from 239.5 km/h, MODEL.md section 7: stated in the fields, not as a level);
+        # on a ramp nothing is identified, so the Hopf interval is the prior's (the vehicle's 0.1358 -+ 0.03): WATCH
+        # from 30 km/h below its lower end (the closed-form Hopf speed at 0.1658, `hunting critical`), WARN from 10
+        # km/h below it, ALARM at the latest just past the Hopf speed at 0.1358 (the basin of the stable origin
+        # shrinks to nothing there); the levels only go up along the ramp
+        out = subprocess.run([rospy.get_param("~hunting"), "critical", "--conicity", "0.1658"], capture_output=True,
+                             text=True, check=True).stdout
+        prior_low = json.loads(out)["v_crit_kmh"]
         self.assertEqual(levels[0], "OK")
         self.assertTrue(any(m.level == HuntingStatus.LEVEL_OK and m.margin_to_lowest_cycle_kmh < 0 for m in seq))
+        self.assertTrue(all(m.conicity_from_prior and not m.conicity_from_estimate for m in seq), "prior in use")
         first_watch = next(m for m in seq if m.level == HuntingStatus.LEVEL_WATCH)
-        self.assertAlmostEqual(first_watch.speed_kmh, 517.618 - 0.483 - 30.0, delta=1.0)
+        self.assertAlmostEqual(first_watch.speed_kmh, prior_low - 30.0, delta=1.0)
+        self.assertAlmostEqual(first_watch.hopf_speed_kmh_low, prior_low, delta=0.01)
         first_warn = next(m for m in seq if m.level == HuntingStatus.LEVEL_WARN)
-        self.assertAlmostEqual(first_warn.speed_kmh, 517.618 - 0.483 - 10.0, delta=1.0)
+        self.assertAlmostEqual(first_warn.speed_kmh, prior_low - 10.0, delta=1.0)
         first_alarm = next(m for m in seq if m.level == HuntingStatus.LEVEL_ALARM)
         self.assertLessEqual(first_alarm.speed_kmh, 517.618 + 3.0)
         self.assertTrue(all(m.level == HuntingStatus.LEVEL_ALARM for m in seq if m.speed_kmh >= 520.0))

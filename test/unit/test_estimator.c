@@ -176,6 +176,39 @@ static void criteria_against_closed_forms(void) {
   }
 }
 
+/* The displacement criterion (issue #18): an oscillation of displacement X at f has acceleration X (2 pi f)^2. At 8
+ * Hz (a bogie mode) 3 mm is 7.6 m/s^2, below the wheelset's acceleration limits (r.m.s. 12, peaks 17), and meets the
+ * 2.1 mm displacement limit; 1.9 mm at 8 Hz does not, 3 mm at 14 Hz does; the bogie frame's point has it off. */
+static void displacement_criterion_at_any_frequency(void) {
+  const struct {
+    double f, x_m;
+    int point, exceeded;
+  } cases[] = {{8.0, 3e-3, HM_POINT_WHEELSET, 1}, {8.0, 1.9e-3, HM_POINT_WHEELSET, 0},
+               {14.0, 3e-3, HM_POINT_WHEELSET, 1}, {8.0, 3e-3, HM_POINT_BOGIE_FRAME, 0}};
+  for (int i = 0; i < 4; ++i) {
+    hm_estimator_config c;
+    hm_estimator_config_default(&c);
+    hm_estimator_config_criteria(&c, (hm_measurement_point)cases[i].point);
+    hm_estimator e = NULL;
+    HM_CHECK(hm_estimator_create(&c, &e, NULL, 0) == HM_OK, "create");
+    const double w = 2.0 * HM_PI * cases[i].f, A = cases[i].x_m * w * w;
+    hm_estimate est;
+    for (long k = 0; k < 2000L * 4; ++k) {
+      const double t = k / 2000.0;
+      if (k % 20 == 0) hm_estimator_push_speed(e, t, 480.0);
+      hm_estimator_push_accel(e, t, A * sin(w * t));
+    }
+    hm_estimator_read(e, 4.0, &est);
+    HM_CHECK_REL(est.amplitude_displacement_m, cases[i].x_m, 0.02, "displacement amplitude");
+    HM_CHECK(est.displacement_exceeded == cases[i].exceeded, "case %d (%g Hz, %g mm): displacement criterion %d", i,
+             cases[i].f, 1e3 * cases[i].x_m, est.displacement_exceeded);
+    if (i == 0)
+      HM_CHECK(!est.peaks_exceeded && !est.rms_exceeded, "8 Hz, 3 mm: the acceleration criteria stay silent (%g m/s^2)",
+               A);
+    hm_estimator_destroy(e);
+  }
+}
+
 /* The wheelset limits are what estimator.h derives them from: an oscillation of half the 4.2 mm unstable cycle at
  * the default vehicle's lower fold (MODEL.md section 7) at the Hopf frequency w^2 = A3/A1 (closed form, linear.h):
  * r.m.s. 2.1 mm w^2 / sqrt(2) and peak 2.1 mm w^2, each within the 1% of their rounding; the bogie-frame limits are
@@ -230,6 +263,62 @@ static void sample_rate_from_stamps(void) {
   hm_estimator_read(e, 399 / 50.0, &est);
   HM_CHECK(!est.sample_rate_supported && !est.accel_valid && est.sample_rate_mismatch, "50 Hz: supported %d valid %d",
            est.sample_rate_supported, est.accel_valid);
+  hm_estimator_destroy(e);
+}
+
+/* Lost samples are not another rate (issue #21): a 2 kHz stream of a 14.12 Hz, 2.2 m/s^2 oscillation losing 1% and
+ * 5% of its samples at random (one in five losses a run of three) reads 2000 Hz (the median stamp difference), no
+ * mismatch and no redesign; the losses counted are the ones the test made after the first 0.5 s block (before it the
+ * grid is not yet confirmed), the loss fraction over the last 10 s within 10% of the test's own count there; the
+ * bridged samples keep amplitude (1%) and frequency (0.2%). Receipt-like stamps (uniform jitter of 0.8 periods) are
+ * not a grid: the rate is still the median's, nothing is counted as lost. */
+static void lost_samples_counted_not_a_rate(void) {
+  const double losses[] = {0.01, 0.05};
+  for (int i = 0; i < 2; ++i) {
+    hm_estimator e = make(2000.0);
+    hm_estimate est;
+    unsigned long dropped_late = 0, dropped_last10 = 0, kept_last10 = 0;
+    const long n = 2000L * 30;
+    for (long k = 0; k < n; ++k) {
+      const double t = 50.0 + k / 2000.0;
+      if (k % 20 == 0) hm_estimator_push_speed(e, t, 400.0);
+      int drop = hm_test_uniform(0.0, 1.0) < losses[i] * 0.6;
+      long run = 1;
+      if (!drop && hm_test_uniform(0.0, 1.0) < losses[i] * 0.4 / 3.0) drop = 1, run = 3;
+      if (drop && k > 0 && k + run < n) {
+        if (t >= 50.5 + 2e-3) dropped_late += (unsigned long)run;
+        if (t >= 50.0 + 20.0) dropped_last10 += (unsigned long)run;
+        k += run - 1;
+        continue;
+      }
+      if (t >= 50.0 + 20.0) ++kept_last10;
+      hm_estimator_push_accel(e, t, 2.2 * sin(2.0 * HM_PI * 14.12 * t));
+    }
+    hm_estimator_read(e, 50.0 + (n - 1) / 2000.0, &est);
+    HM_CHECK_REL(est.sample_rate_measured_hz, 2000.0, 1e-6, "measured rate");
+    HM_CHECK(!est.sample_rate_mismatch && est.n_rate_changes == 0 && est.stamps_regular && est.n_gaps == 0,
+             "%g loss: mismatch %d, %lu redesigns, regular %d, %lu gaps", losses[i], est.sample_rate_mismatch,
+             est.n_rate_changes, est.stamps_regular, est.n_gaps);
+    HM_CHECK(est.n_samples_lost >= dropped_late && est.n_samples_lost <= dropped_late + 8,
+             "%g loss: %lu counted, %lu dropped after the first block", losses[i], est.n_samples_lost, dropped_late);
+    const double frac = (double)dropped_last10 / (double)(dropped_last10 + kept_last10);
+    HM_CHECK_REL(est.loss_fraction, frac, 0.1, "loss fraction over the last 10 s");
+    HM_CHECK_REL(est.amplitude_accel_mps2, 2.2, 0.01, "amplitude");
+    HM_CHECK_REL(est.frequency_hz, 14.12, 0.002, "frequency");
+    hm_estimator_destroy(e);
+  }
+  hm_estimator e = make(2000.0);
+  hm_estimate est;
+  for (long k = 0; k < 2000L * 5; ++k) {
+    const double t = 10.0 + (k + hm_test_uniform(0.0, 0.8)) / 2000.0;
+    if (k % 20 == 0) hm_estimator_push_speed(e, t, 400.0);
+    hm_estimator_push_accel(e, t, sin(2.0 * HM_PI * 14.12 * t));
+  }
+  hm_estimator_read(e, 15.0, &est);
+  HM_CHECK_REL(est.sample_rate_measured_hz, 2000.0, 0.02, "jittered stamps: rate");
+  HM_CHECK(!est.stamps_regular && est.n_samples_lost == 0 && !est.sample_rate_mismatch,
+           "jittered stamps: regular %d, %lu lost, mismatch %d", est.stamps_regular, est.n_samples_lost,
+           est.sample_rate_mismatch);
   hm_estimator_destroy(e);
 }
 
@@ -340,7 +429,9 @@ int main(int argc, char **argv) {
   HM_RUN(chirp_and_amplitude_step);
   HM_RUN(criteria_against_closed_forms);
   HM_RUN(wheelset_limits_from_the_model);
+  HM_RUN(displacement_criterion_at_any_frequency);
   HM_RUN(sample_rate_from_stamps);
+  HM_RUN(lost_samples_counted_not_a_rate);
   HM_RUN(bad_input_is_skipped);
   HM_RUN(long_stream_no_allocation);
   HM_RUN(bad_configuration);

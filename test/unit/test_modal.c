@@ -117,6 +117,135 @@ static void rates_and_no_mode(void) {
   hm_modal_destroy(m);
 }
 
+/* Rail joints are not the mode (issue #18): the oscillator of the first test (sigma -2 1/s at 14 Hz) forced as well
+ * by a comb of lines at multiples of 4.667 Hz (25 m joints at 420 km/h; the third on the mode's peak, 14.0 Hz), 12
+ * windows of 40 s. Left out of the fit (the default), the decay rate's mean is within 3 standard errors of the
+ * reference, 9 or more of the 12 intervals cover it and the comb's spacing is reported to 5 mHz; fitted with the
+ * lines (reject_lines 0) the same windows fail that test (fits invalid, or intervals that miss the reference): the
+ * failure this guards against. */
+static void joints_are_not_the_mode(void) {
+  const double sigma = -2.0, fs = 1000.0, wd = 2.0 * HM_PI * 14.0, w = hypot(wd, sigma), f1 = 116.6667 / 25.0;
+  for (int reject = 1; reject >= 0; --reject) {
+    sdof s = {0.0, 0.0, w, -sigma / w};
+    hm_modal_config c;
+    hm_modal_config_default(&c);
+    c.reject_lines = reject;
+    hm_modal m = NULL;
+    HM_CHECK(hm_modal_create(&c, fs, &m, NULL, 0) == HM_OK, "create");
+    if (!m) return;
+    double ms = 0.0;
+    for (int k = 0; k < 20000; ++k) {
+      const double a = sdof_step(&s, 1000.0 * noise(), 1.0 / fs);
+      if (k >= 10000) ms += a * a / 10000.0;
+    }
+    /* each harmonic's amplitude: a third of the response's r.m.s. (the one on the peak stands about 40x above the
+     * mode's spectrum there in a 40 s window) */
+    const double amp = sqrt(ms) / 3.0;
+    double sum = 0.0, sum_se = 0.0, sum_f1 = 0.0, t = 0.0;
+    int n = 0, covered = 0, combs = 0;
+    for (int win = 0; win < 12; ++win) {
+      hm_modal_reset(m);
+      for (long k = 0; k < (long)(40.0 * fs); ++k, t += 1.0 / fs) {
+        double lines = 0.0;
+        for (int h = 1; h <= 5; ++h) lines += amp * sin(2.0 * HM_PI * h * f1 * t + h);
+        hm_modal_push(m, sdof_step(&s, 1000.0 * noise(), 1.0 / fs) + lines);
+      }
+      hm_mode_estimate e;
+      if (hm_modal_fit(m, 40.0, &e) != HM_OK || !e.valid) continue;
+      ++n;
+      sum += e.decay_rate_1_s;
+      sum_se += e.decay_rate_se_1_s;
+      covered += fabs(e.decay_rate_1_s - sigma) <= 2.0 * e.decay_rate_se_1_s;
+      if (e.lines_found) ++combs, sum_f1 += e.line_fundamental_hz;
+    }
+    hm_modal_destroy(m);
+    if (n == 0) {
+      HM_CHECK(!reject, "no valid fit with the lines left out");
+      continue;
+    }
+    const double mean = sum / n, se_mean = sum_se / n / sqrt((double)n);
+    printf("  joints, lines %s: decay rate %.3f (se of the mean %.3f, reference %.1f), %d/%d intervals cover, comb in "
+           "%d windows at %.4f Hz (true %.4f)\n",
+           reject ? "left out" : "fitted", mean, se_mean, sigma, covered, n, combs, combs ? sum_f1 / combs : 0.0, f1);
+    HM_CHECK(combs == n, "reject %d: comb found in %d of %d windows", reject, combs, n);
+    if (combs) HM_CHECK_DELTA(sum_f1 / combs, f1, 5e-3, "comb spacing");
+    const int good = n >= 10 && covered >= 9 && fabs(mean - sigma) <= 3.0 * se_mean;
+    if (reject) {
+      HM_CHECK(n >= 10, "only %d valid fits", n);
+      HM_CHECK_DELTA(mean, sigma, 3.0 * se_mean, "decay rate with the lines left out");
+      HM_CHECK(covered >= 9, "only %d of %d intervals cover the reference", covered, n);
+    } else {
+      HM_CHECK(!good, "fitted with the lines the identification is as good: the test lost its point");
+    }
+  }
+}
+
+/* The coverage of the decay rate's 2-standard-error intervals (issue #18), Monte Carlo over 384 windows: a pole pair
+ * at 14 Hz with decay rates -0.05, -0.2, -1 and -4 1/s (damping ratios 0.0006 to 0.045: from at the Hopf speed to
+ * 100 km/h below it), windows of 20 and 40 s, input rates 2000, 1250 and 250 Hz (decimation 20, 12 and 2: the
+ * periodogram zero-padded by 1.02, 1.97 and 1.64), 16 windows each, plus 10% white sensor noise. The process is the
+ * pole pair's exact discretisation, x_k = 2 r cos(w0 / fs) x_k-1 - r^2 x_k-2 + e_k with r = exp(sigma / fs): its
+ * spectrum has the continuous pole s = sigma + i w0 over a smooth background. Reported: the share of intervals that
+ * cover sigma with the statistical error alone and with the leakage term 1 / T added linearly (as the margin adds it,
+ * margin.h); the test holds the latter to at least 90% overall and 75% in every cell. */
+static void coverage_of_the_intervals(void) {
+  const double sigmas[] = {-0.05, -0.2, -1.0, -4.0}, windows[] = {20.0, 40.0}, rates[] = {2000.0, 1250.0, 250.0};
+  const int per_cell = 16;
+  int n_all = 0, cov_stat = 0, cov_leak = 0, worst = per_cell;
+  for (int si = 0; si < 4; ++si) {
+    int cell_stat = 0, cell_leak = 0, cell_n = 0;
+    for (int wi = 0; wi < 2; ++wi)
+      for (int ri = 0; ri < 3; ++ri) {
+        const double fs = rates[ri], T = windows[wi], sg = sigmas[si], w0 = 2.0 * HM_PI * 14.0;
+        const double r = exp(sg / fs), a1 = 2.0 * r * cos(w0 / fs), a2 = -r * r;
+        hm_modal_config c;
+        hm_modal_config_default(&c);
+        c.window_s = T;
+        c.min_window_s = fmin(c.min_window_s, T);
+        hm_modal m = NULL;
+        HM_CHECK(hm_modal_create(&c, fs, &m, NULL, 0) == HM_OK, "create");
+        if (!m) return;
+        double x1 = 0.0, x2 = 0.0;
+        for (long k = 0; k < (long)(200.0 * fs); ++k) { /* settle: 10 decay times of the slowest */
+          const double x = a1 * x1 + a2 * x2 + noise();
+          x2 = x1, x1 = x;
+        }
+        int n = 0, in_stat = 0, in_leak = 0;
+        for (int win = 0; win < per_cell; ++win) {
+          hm_modal_reset(m);
+          double ms = 0.0;
+          const long ns = (long)(T * fs);
+          static double buf[40 * 2000];
+          for (long k = 0; k < ns; ++k) {
+            const double x = a1 * x1 + a2 * x2 + noise();
+            x2 = x1, x1 = x;
+            buf[k] = x;
+            ms += x * x / (double)ns;
+          }
+          const double sensor = 0.1 * sqrt(ms);
+          for (long k = 0; k < ns; ++k) hm_modal_push(m, buf[k] + sensor * noise());
+          hm_mode_estimate e;
+          if (hm_modal_fit(m, T, &e) != HM_OK || !e.valid) continue;
+          ++n;
+          const double d = fabs(e.decay_rate_1_s - sg);
+          in_stat += d <= 2.0 * e.decay_rate_se_1_s;
+          in_leak += d <= 2.0 * (e.decay_rate_se_1_s + 1.0 / T);
+        }
+        hm_modal_destroy(m);
+        HM_CHECK(n >= per_cell - 2, "sigma %g, %g s, %g Hz: only %d valid fits", sg, T, fs, n);
+        cell_n += n, cell_stat += in_stat, cell_leak += in_leak;
+        worst = in_leak * per_cell < worst * n ? in_leak * per_cell / (n ? n : 1) : worst;
+        HM_CHECK(in_leak >= 0.75 * n, "sigma %g, %g s, %g Hz: %d/%d covered", sg, T, fs, in_leak, n);
+      }
+    printf("  sigma %5.2f: %3d windows, covered %5.1f%% (statistical error), %5.1f%% (with 1/T)\n", sigmas[si], cell_n,
+           100.0 * cell_stat / cell_n, 100.0 * cell_leak / cell_n);
+    n_all += cell_n, cov_stat += cell_stat, cov_leak += cell_leak;
+  }
+  printf("  all: %d windows, 2-sigma coverage %.1f%% (statistical error), %.1f%% (with 1/T)\n", n_all,
+         100.0 * cov_stat / n_all, 100.0 * cov_leak / n_all);
+  HM_CHECK(cov_leak >= 0.9 * n_all, "coverage %d/%d below 90%%", cov_leak, n_all);
+}
+
 static void bad_configuration(void) {
   hm_modal_config c;
   char why[128];
@@ -137,6 +266,8 @@ static void bad_configuration(void) {
 int main(void) {
   HM_RUN(decay_rate_of_a_known_oscillator);
   HM_RUN(rates_and_no_mode);
+  HM_RUN(joints_are_not_the_mode);
+  HM_RUN(coverage_of_the_intervals);
   HM_RUN(bad_configuration);
   HM_TEST_EXIT();
 }

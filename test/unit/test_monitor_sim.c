@@ -205,27 +205,28 @@ static void table_refined_at_the_conicity_in_use(void) {
   run_free(&r);
 }
 
-/* Settings changed while monitoring (commissioning): at 480 km/h (OK: 37.6 km/h below the Hopf speed, WATCH starts
- * 30 km/h below the interval) a 40 km/h WATCH margin makes the next status WATCH; an invalid value is refused with
+/* Settings changed while monitoring (commissioning): at 425 km/h before identification (OK: 39.8 km/h below the
+ * prior's Hopf interval, 464.8..593.8 km/h, WATCH starts 30 km/h below it) a 45 km/h WATCH margin makes the next
+ * status WATCH; an invalid value is refused with
  * its reason and the running settings kept; a criterion limit below the running r.m.s. gives the criterion's ALARM;
  * a field that needs a new monitor (the sample rate) is not taken over. */
 static void settings_changed_while_running(void) {
   run_state r;
-  run_init(&r, 480.0, 0.01, 42, 4);
+  run_init(&r, 425.0, 0.01, 42, 4);
   run_segment(&r, 5.0);
   HM_CHECK(r.last.assessment.level == HM_LEVEL_OK, "level %s before", hm_level_name(r.last.assessment.level));
   hm_monitor_config c;
   hm_monitor_settings(r.mon, &c);
-  c.alarm.watch_speed_margin_kmh = 40.0;
+  c.alarm.watch_speed_margin_kmh = 45.0;
   c.estimator.sample_rate_hz = 500.0; /* ignored: needs a new monitor */
   char why[256] = "";
   HM_CHECK(hm_monitor_set_runtime_settings(r.mon, &c, why, sizeof why) == HM_OK, "valid change: %s", why);
   run_segment(&r, 5.2);
   HM_CHECK(r.last.assessment.level == HM_LEVEL_WATCH && r.last.assessment.reason == HM_REASON_APPROACHING_HOPF,
-           "level %s after the WATCH margin went to 40 km/h", hm_level_name(r.last.assessment.level));
+           "level %s after the WATCH margin went to 45 km/h", hm_level_name(r.last.assessment.level));
   hm_monitor_config now;
   hm_monitor_settings(r.mon, &now);
-  HM_CHECK(now.alarm.watch_speed_margin_kmh == 40.0 && now.estimator.sample_rate_hz == 2000.0, "running settings");
+  HM_CHECK(now.alarm.watch_speed_margin_kmh == 45.0 && now.estimator.sample_rate_hz == 2000.0, "running settings");
   hm_monitor_config bad = now;
   bad.alarm.hysteresis_kmh = -1.0;
   HM_CHECK(hm_monitor_set_runtime_settings(r.mon, &bad, why, sizeof why) == HM_EDOMAIN &&

@@ -1,0 +1,177 @@
+/* Periodic track excitation: a comb of spectral lines at multiples of V / L (see lines.h). */
+#include "hunting_monitor/lines.h"
+
+#include "hunting_monitor/model.h"
+
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "select.h"
+
+enum { MAX_CANDIDATES = 32, MAX_DIVISOR = 12 };
+
+struct hm_lines_s {
+  hm_lines_config cfg;
+  size_t max_bins;
+  double *bg;      /* local background per bin */
+  double *window;  /* median scratch */
+  size_t window_cap;
+};
+
+void hm_lines_config_default(hm_lines_config *c) {
+  c->candidate_ratio = 8.0;
+  c->background_halfwidth_hz = 0.5;
+  c->min_fundamental_hz = 1.5;
+  c->min_harmonics = 3;
+  c->leakage = 0.1;
+}
+
+hm_status hm_lines_config_validate(const hm_lines_config *c, char *why, size_t len) {
+  const char *field = NULL, *rule = NULL;
+  double got = 0.0;
+  if (!c) return HM_EINVAL;
+  if (!(c->candidate_ratio >= 3.0 && c->candidate_ratio <= 1e4))
+    field = "candidate_ratio", rule = "must be in 3..1e4", got = c->candidate_ratio;
+  else if (!(c->background_halfwidth_hz >= 0.05 && c->background_halfwidth_hz <= 5.0))
+    field = "background_halfwidth_hz", rule = "must be in 0.05..5", got = c->background_halfwidth_hz;
+  else if (!(c->min_fundamental_hz >= 0.1 && c->min_fundamental_hz <= 100.0))
+    field = "min_fundamental_hz", rule = "must be in 0.1..100", got = c->min_fundamental_hz;
+  else if (c->min_harmonics < 2 || c->min_harmonics > 20)
+    field = "min_harmonics", rule = "must be 2..20", got = c->min_harmonics;
+  else if (!(c->leakage > 0.0 && c->leakage <= 1.0))
+    field = "leakage", rule = "must be in (0, 1]", got = c->leakage;
+  if (!field) return HM_OK;
+  if (why && len) snprintf(why, len, "%s: %s (got %g)", field, rule, got);
+  return HM_EDOMAIN;
+}
+
+hm_status hm_lines_create(const hm_lines_config *cfg, size_t max_bins, hm_lines *out, char *why, size_t len) {
+  if (!cfg || !out || max_bins == 0) return HM_EINVAL;
+  const hm_status st = hm_lines_config_validate(cfg, why, len);
+  if (st != HM_OK) return st;
+  hm_lines l = calloc(1, sizeof *l);
+  if (!l) return HM_ENOMEM;
+  l->cfg = *cfg;
+  l->max_bins = max_bins;
+  l->window_cap = max_bins;
+  l->bg = malloc(max_bins * sizeof(double));
+  l->window = malloc(max_bins * sizeof(double));
+  if (!l->bg || !l->window) {
+    hm_lines_destroy(l);
+    return HM_ENOMEM;
+  }
+  *out = l;
+  return HM_OK;
+}
+
+void hm_lines_destroy(hm_lines l) {
+  if (!l) return;
+  free(l->bg);
+  free(l->window);
+  free(l);
+}
+
+typedef struct {
+  double f, ratio;
+  size_t k;
+} candidate;
+
+hm_status hm_lines_find(hm_lines l, const double *p, size_t n, double df, double T, double f_lo, double f_hi,
+                        unsigned char *exclude, hm_lines_result *out) {
+  if (!l || !p || !exclude || !out || n == 0 || n > l->max_bins || !(df > 0.0) || !(T > 0.0)) return HM_EINVAL;
+  const hm_lines_config *c = &l->cfg;
+  hm_lines_result r;
+  memset(&r, 0, sizeof r);
+  memset(exclude, 0, n);
+  const size_t h = (size_t)fmax(2.0, round(c->background_halfwidth_hz / df));
+  size_t k_lo = (size_t)fmax(1.0, ceil(f_lo / df)), k_hi = (size_t)fmin((double)(n - 2), floor(f_hi / df));
+  if (k_hi <= k_lo + 2) {
+    *out = r;
+    return HM_OK;
+  }
+  /* local backgrounds and the candidates (local maxima over +- a main lobe, at least two bins) */
+  const size_t lobe = (size_t)fmax(2.0, round(0.5 / (T * df)));
+  for (size_t k = k_lo; k <= k_hi; ++k) {
+    const size_t a = k > h ? k - h : 1, b = k + h < n ? k + h : n - 1;
+    memcpy(l->window, p + a, (b - a + 1) * sizeof(double));
+    l->bg[k] = hm_select_kth(l->window, b - a + 1, (b - a + 1) / 2) / log(2.0);
+  }
+  candidate cand[MAX_CANDIDATES];
+  size_t nc = 0;
+  for (size_t k = k_lo; k <= k_hi; ++k) {
+    if (!(l->bg[k] > 0.0)) continue;
+    const double ratio = p[k] / l->bg[k];
+    if (ratio < c->candidate_ratio) continue;
+    int is_max = 1;
+    for (size_t j = k > lobe ? k - lobe : 0; j <= k + lobe && j < n && is_max; ++j)
+      if (j != k && p[j] > p[k]) is_max = 0;
+    if (!is_max) continue;
+    ++r.candidates;
+    /* the parabola through the logarithms of the three bins at the peak */
+    const double ym = log(fmax(p[k - 1], 1e-300)), y0 = log(p[k]), yp = log(fmax(p[k + 1], 1e-300));
+    const double den = ym - 2.0 * y0 + yp;
+    const double delta = den < 0.0 ? fmax(-0.5, fmin(0.5, 0.5 * (ym - yp) / den)) : 0.0;
+    const candidate cd = {((double)k + delta) * df, ratio, k};
+    if (nc < MAX_CANDIDATES) {
+      cand[nc++] = cd;
+    } else { /* keep the strongest */
+      size_t weakest = 0;
+      for (size_t i = 1; i < nc; ++i)
+        if (cand[i].ratio < cand[weakest].ratio) weakest = i;
+      if (cand[weakest].ratio < ratio) cand[weakest] = cd;
+    }
+  }
+  /* the comb that best explains the candidates: each one on a tooth counts 1, each tooth in the range without one
+   * costs 1/2 (a sub-harmonic comb f1 / j holds every line of f1 and chance candidates, but misses most of its
+   * teeth); then the largest spacing */
+  double best_f1 = 0.0, best_score = -INFINITY;
+  unsigned best_count = 0;
+  for (size_t i = 0; i < nc; ++i)
+    for (int d = 1; d <= MAX_DIVISOR; ++d) {
+      const double f1 = cand[i].f / d;
+      if (f1 < c->min_fundamental_hz) break;
+      unsigned count = 0;
+      for (size_t j = 0; j < nc; ++j) {
+        const double m = floor(cand[j].f / f1 + 0.5);
+        if (m >= 1.0 && fabs(cand[j].f - m * f1) <= (0.5 + 0.5 * m / d) / T) ++count;
+      }
+      const double teeth = floor(f_hi / f1) - ceil(f_lo / f1) + 1.0;
+      const double score = (double)count - 0.5 * fmax(0.0, teeth - (double)count);
+      if (score > best_score || (score == best_score && f1 > best_f1))
+        best_score = score, best_count = count, best_f1 = f1;
+    }
+  r.found = best_count >= c->min_harmonics;
+  if (r.found) {
+    /* least squares through the matched harmonics: f_j = m_j f1 */
+    double smf = 0.0, smm = 0.0;
+    for (size_t j = 0; j < nc; ++j) {
+      const double m = floor(cand[j].f / best_f1 + 0.5);
+      if (m >= 1.0 && fabs(cand[j].f - m * best_f1) <= (0.5 + 0.5 * m) / T) {
+        smf += m * cand[j].f, smm += m * m;
+        if (cand[j].ratio > r.strongest_ratio) {
+          r.strongest_ratio = cand[j].ratio;
+          r.strongest_hz = cand[j].f;
+          r.strongest_bin = cand[j].k;
+        }
+      }
+    }
+    const double f1 = smm > 0.0 ? smf / smm : best_f1;
+    r.fundamental_hz = f1;
+    r.harmonics = best_count;
+    /* every multiple in the range, over its line's leakage */
+    for (double m = 1.0; m * f1 <= f_hi + c->background_halfwidth_hz; m += 1.0) {
+      const double fm = m * f1;
+      double ratio = 1.0;
+      for (size_t j = 0; j < nc; ++j)
+        if (fabs(cand[j].f - fm) <= (0.5 + 0.5 * m) / T) ratio = fmax(ratio, cand[j].ratio);
+      const double w = fmin(c->background_halfwidth_hz, fmax(2.0 / T, sqrt(ratio / c->leakage) / (HM_PI * T)));
+      const double a = fmax(0.0, ceil((fm - w) / df)), b = fmin((double)(n - 1), floor((fm + w) / df));
+      for (double k = a; k <= b; k += 1.0)
+        if (!exclude[(size_t)k]) exclude[(size_t)k] = 1, ++r.bins_excluded;
+    }
+  }
+  *out = r;
+  return HM_OK;
+}
