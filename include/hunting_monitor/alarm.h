@@ -39,7 +39,8 @@
  * Latching by cause (issue #21): an ALARM from the oscillation (a criterion, or the amplitude at or beyond the
  * unstable cycle) is latched: it holds, with its reason, until the oscillation has stayed calm for release_s (no
  * criterion met, the displacement amplitude below release_amplitude_fraction of the displacement criterion's limit,
- * or of the edge where that limit is off) and the speed is below the lower end of the Hopf interval; the status says
+ * or of the edge where that limit is off) and the speed is below the lower end of the Hopf interval by the
+ * hysteresis_kmh (the ALARM level's speed thresholds are relaxed by it, as everywhere); the status says
  * that the level is held and why (latched, release_in_s). A hunting wheelset's oscillation comes and goes with the
  * track; the driver's "reduce speed now" must not. A speed-only ALARM follows the speed with the hysteresis. Stale
  * input shows NO_DATA but keeps the latch: when data returns the ALARM is back until the calm is seen.

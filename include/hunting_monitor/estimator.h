@@ -37,12 +37,14 @@
  * is measured from the time stamps over blocks of 0.5 s of gap-free data: from regular stamps (a sensor's clock,
  * below) the reciprocal of the median stamp difference (so samples lost or delivered late do not read as another
  * rate: a count per block would), from irregular ones (receipt times in bursts) the count per time; when two
- * blocks in a row differ from the design by more than 2% the filters are redesigned for the measured rate (and
- * restarted). A measured rate more than 5% from the configured one is reported (sample_rate_mismatch); one the bands
+ * blocks in a row differ from the design by more than 5% the filters are redesigned for the measured rate (and
+ * restarted: the bands then move by less than 5%, while every restart leaves the tracker unsettled for a second, so
+ * a source whose rate wanders by a few per cent, such as a publisher loop on a loaded computer, is not restarted
+ * over and over). A measured rate more than 5% from the configured one is reported (sample_rate_mismatch); one the bands
  * cannot be designed for (below 100 Hz, above 5 kHz, or with a band edge above 0.45 of it) makes the acceleration
  * invalid.
  * Lost samples: when a block's stamps are regular (95% of the differences within 0.25 periods of a whole number of
- * median differences: a sensor's own clock; receipt times in bursts are not) at a rate within 2% of the design, a
+ * median differences: a sensor's own clock; receipt times in bursts are not) at a rate within 5% of the design, a
  * difference of k >= 2 periods (up to max_gap_s) counts k - 1 lost samples (n_samples_lost; loss_fraction over about
  * the last 10 s) and is bridged by k - 1 linearly interpolated samples, so the filters, trackers and criteria stay on
  * their time grid (hm_estimator_last_fill tells a consumer of the same stream how many).

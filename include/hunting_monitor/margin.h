@@ -96,7 +96,9 @@ typedef enum {
   HM_WINDOW_OVERLAPS = 4,
   HM_WINDOW_NO_INVERSION = 5,
   HM_WINDOW_MISFIT = 6,     /* the model explains its decay rate and frequency together no better than chi2 limit */
-  HM_WINDOW_CHANGE = 7      /* its conicity disagrees with the windows held: they were dropped, and so was it */
+  HM_WINDOW_CHANGE = 7,     /* its conicity disagrees with the windows held: they were dropped, and so was it */
+  HM_WINDOW_NONLINEAR = 8   /* a criterion was met during it: hunting or its onset is not the linear mode
+                               (monitor.h) */
 } hm_window_verdict;
 
 typedef struct hm_margin_s *hm_margin;

@@ -14,7 +14,10 @@
  *  - the identification follows the estimator: restarted after a gap, redesigned for a measured sample rate, fed
  *    the same interpolated samples where the estimator bridged lost ones.
  * At a steady speed the identification's windows go to the margin with the speed's mean and range: the current
- * stretch provisionally (from min_window_s), committed in full windows (window_s) and when the stretch ends.
+ * stretch provisionally (from min_window_s), committed in full windows (window_s) and when the stretch ends. A window
+ * during which an update saw a criterion met (hunting or its onset: sliding r.m.s., peaks, displacement) is not given
+ * to the margin (HM_WINDOW_NONLINEAR): a hunting limit cycle is not the linear mode, and its "decay rate" of about
+ * zero would read as a Hopf speed at the current speed (on the independent simulator it once read 168 km/h).
  * No allocation after create.
  */
 #ifndef HUNTING_MONITOR_MONITOR_H

@@ -189,13 +189,14 @@ static int oscillation_reason(hm_reason r) {
          r == HM_REASON_AMPLITUDE_BEYOND_EDGE;
 }
 
-/* The latch's release conditions: no criterion, the oscillation small, the speed below the Hopf interval. */
+/* The latch's release conditions: no criterion, the oscillation small, the speed below the Hopf interval by the
+ * hysteresis (the ALARM level's thresholds are relaxed by it, as everywhere). */
 static int calm_now(const hm_alarm a, const hm_estimate *e, const hm_assessment *s) {
   const double f = a->cfg.release_amplitude_fraction;
   const double limit = a->displacement_limit_m > 0.0 ? a->displacement_limit_m : s->edge_used_m;
   const int small = limit > 0.0 ? s->amplitude_m < f * limit : s->amplitude_m < f * 2.1e-3;
   return !e->rms_exceeded && !e->peaks_exceeded && !e->displacement_exceeded && small &&
-         e->speed_kmh < s->hopf_low_kmh;
+         e->speed_kmh < s->hopf_low_kmh - a->cfg.hysteresis_kmh;
 }
 
 hm_status hm_alarm_set_config(hm_alarm a, const hm_alarm_config *cfg, const hm_vehicle *veh, char *why,

@@ -52,7 +52,7 @@ struct hm_estimator_s {
 };
 
 enum { RATE_BLOCKS_TO_REDESIGN = 2 };
-static const double RATE_BLOCK_S = 0.5, RATE_REDESIGN_TOL = 0.02, RATE_MISMATCH_TOL = 0.05;
+static const double RATE_BLOCK_S = 0.5, RATE_REDESIGN_TOL = 0.05, RATE_MISMATCH_TOL = 0.05;
 /* a block's stamps are regular when this fraction of its differences lie within GRID_TOL periods of a whole number
  * (1 or more) of median differences: a sensor's own clock, not receipt times in bursts */
 static const double GRID_FRACTION = 0.95, GRID_TOL = 0.25;

@@ -8,7 +8,6 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "select.h"
 
 enum { MAX_CANDIDATES = 32, MAX_DIVISOR = 12 };
 
@@ -16,7 +15,7 @@ struct hm_lines_s {
   hm_lines_config cfg;
   size_t max_bins;
   double *bg;      /* local background per bin */
-  double *window;  /* median scratch */
+  double *window;  /* the running median's window, sorted */
   size_t window_cap;
 };
 
@@ -78,6 +77,32 @@ typedef struct {
   size_t k;
 } candidate;
 
+/* The position of the first element of x[0..m) not below v (x sorted). */
+static size_t lower_bound(const double *x, size_t m, double v) {
+  size_t lo = 0, hi = m;
+  while (lo < hi) {
+    const size_t mid = lo + (hi - lo) / 2;
+    if (x[mid] < v) lo = mid + 1;
+    else hi = mid;
+  }
+  return lo;
+}
+
+static void sorted_insert(double *x, size_t *m, double v) {
+  const size_t i = lower_bound(x, *m, v);
+  memmove(x + i + 1, x + i, (*m - i) * sizeof(double));
+  x[i] = v;
+  ++*m;
+}
+
+/* Remove one element equal to v (it is there: the window holds it). */
+static void sorted_remove(double *x, size_t *m, double v) {
+  const size_t i = lower_bound(x, *m, v);
+  if (i >= *m) return;
+  memmove(x + i, x + i + 1, (*m - i - 1) * sizeof(double));
+  --*m;
+}
+
 hm_status hm_lines_find(hm_lines l, const double *p, size_t n, double df, double T, double f_lo, double f_hi,
                         unsigned char *exclude, hm_lines_result *out) {
   if (!l || !p || !exclude || !out || n == 0 || n > l->max_bins || !(df > 0.0) || !(T > 0.0)) return HM_EINVAL;
@@ -93,10 +118,13 @@ hm_status hm_lines_find(hm_lines l, const double *p, size_t n, double df, double
   }
   /* local backgrounds and the candidates (local maxima over +- a main lobe, at least two bins) */
   const size_t lobe = (size_t)fmax(2.0, round(0.5 / (T * df)));
+  /* the running median: the window's values kept sorted, one value out and one in per bin (O(h) a bin) */
+  size_t wa = k_lo > h ? k_lo - h : 1, wb = wa, nw = 0; /* the window is p[wa, wb) */
   for (size_t k = k_lo; k <= k_hi; ++k) {
-    const size_t a = k > h ? k - h : 1, b = k + h < n ? k + h : n - 1;
-    memcpy(l->window, p + a, (b - a + 1) * sizeof(double));
-    l->bg[k] = hm_select_kth(l->window, b - a + 1, (b - a + 1) / 2) / log(2.0);
+    const size_t a = k > h ? k - h : 1, b = k + h < n ? k + h + 1 : n;
+    for (; wa < a; ++wa) sorted_remove(l->window, &nw, p[wa]);
+    for (; wb < b; ++wb) sorted_insert(l->window, &nw, p[wb]);
+    l->bg[k] = l->window[nw / 2] / log(2.0);
   }
   candidate cand[MAX_CANDIDATES];
   size_t nc = 0;

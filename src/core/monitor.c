@@ -37,6 +37,7 @@ struct hm_monitor_s {
   double conicity_in_use;        /* of the latest update that had data; NAN before */
   double refine_failed_at;       /* the conicity whose exact family could not be computed; NAN if none */
   double a_prev;                 /* the previous accepted acceleration sample (bridging lost samples) */
+  double large_at;               /* the latest update that saw a large oscillation (-inf: none) */
 };
 
 void hm_monitor_config_default(hm_monitor_config *c) {
@@ -135,6 +136,7 @@ hm_status hm_monitor_create_parallel(const hm_monitor_config *cfg, const hm_vehi
   }
   hm_alarm_set_displacement_limit(m->alarm, cfg->estimator.displacement_limit_m);
   m->modal_ok = 1;
+  m->large_at = -INFINITY;
   m->conicity_in_use = NAN;
   m->refine_failed_at = NAN;
   m->restarts = hm_estimator_restarts(m->est, &m->rate_hz);
@@ -162,6 +164,7 @@ void hm_monitor_reset(hm_monitor m) {
   m->have_speed = 0;
   memset(&m->mode, 0, sizeof m->mode);
   hm_margin_reset(m->margin); /* its windows' times are on the old time line */
+  m->large_at = -INFINITY;
   restart_stream(m);
   hm_alarm_reset(m->alarm);
 }
@@ -206,6 +209,12 @@ static void fit(hm_monitor m, double t) {
   m->mode_spread = is_steady ? steady.max - steady.min : INFINITY;
   m->verdict = is_steady ? HM_WINDOW_OVERLAPS : HM_WINDOW_SPEED_VARIED;
   if (!for_margin) return;
+  if (t - e.window_s <= m->large_at) { /* a large oscillation in the window: not the linear mode */
+    m->verdict = HM_WINDOW_NONLINEAR;
+    hm_margin_commit_pending(m->margin); /* what the stretch gave before it stays; nothing of it after */
+    m->committed_until = t;
+    return;
+  }
   if (e.window_s >= mc->window_s * (1.0 - 1e-9)) {
     hm_margin_add_window(m->margin, t, m->mode_speed, m->mode_spread, &e, &m->verdict);
     if (m->verdict == HM_WINDOW_USED) m->committed_until = t;
@@ -264,6 +273,8 @@ hm_status hm_monitor_update(hm_monitor m, double now, hm_monitor_status *out) {
   hm_monitor_status s;
   memset(&s, 0, sizeof s);
   hm_estimator_read(m->est, now, &s.estimate);
+  if (s.estimate.rms_exceeded || s.estimate.peaks_exceeded || s.estimate.displacement_exceeded)
+    m->large_at = s.estimate.time_s;
   hm_margin_read(m->margin, now, &s.margin);
   const hm_status st = hm_alarm_update(m->alarm, &s.estimate, &s.margin, now, &s.assessment);
   if (st != HM_OK) return st;

@@ -1,5 +1,4 @@
-/* Internal: order statistics of a double array (the estimator's median stamp difference, the line search's local
- * background). */
+/* Internal: order statistics of a double array (the estimator's median stamp difference). */
 #ifndef HUNTING_MONITOR_SELECT_H
 #define HUNTING_MONITOR_SELECT_H
 

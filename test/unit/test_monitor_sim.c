@@ -27,6 +27,7 @@ typedef struct {
   double first_alarm_amp, first_alarm_rms, true_amp_max;
   double edge_m;           /* unstable cycle amplitude at the run's speed (direct continuation) */
   int levels_seen[5];
+  int verdicts_seen[16];   /* the identification's window verdicts (margin.h) seen by the updates */
   hm_level last_level;
   hm_monitor_status last;
 } run_state;
@@ -47,6 +48,7 @@ static int on_accel(void *ctx, double t, double measured, double true_accel, con
     const hm_assessment s = st.assessment;
     r->last = st;
     if (t > 2.0) r->levels_seen[s.level]++;
+    if ((unsigned)st.mode_verdict < 16) r->verdicts_seen[st.mode_verdict]++;
     if (s.level == HM_LEVEL_ALARM && r->first_alarm_s < 0.0) {
       r->first_alarm_s = t;
       r->first_alarm_reason = s.reason;
@@ -156,6 +158,16 @@ static void hunting_onset_alarms_within_a_second(void) {
   HM_CHECK(r.first_alarm_s <= r.t_true_beyond + 1.0, "ALARM %.2f s after the exceedance",
            r.first_alarm_s - r.t_true_beyond);
   HM_CHECK(r.last_level == HM_LEVEL_ALARM && r.true_amp > 0.012, "sustained hunting not alarmed");
+  /* hunting is not the linear mode: no window of it reaches the margin (monitor.h), the interval stays the prior's */
+  run_segment(&r, 45.0);
+  printf("  hunting to 45 s: %d statuses with a window refused as nonlinear, %u windows held, level %s%s\n",
+         r.verdicts_seen[HM_WINDOW_NONLINEAR], r.last.margin.n_windows, hm_level_name(r.last_level),
+         r.last.assessment.latched ? " (latched)" : "");
+  HM_CHECK(r.verdicts_seen[HM_WINDOW_NONLINEAR] > 0 && r.last.margin.n_windows == 0 &&
+               r.last.assessment.conicity_from_prior,
+           "a window of the limit cycle was used: %d nonlinear verdicts, %u windows",
+           r.verdicts_seen[HM_WINDOW_NONLINEAR], r.last.margin.n_windows);
+  HM_CHECK(r.last_level == HM_LEVEL_ALARM && r.last.assessment.latched, "the hunting ALARM is not held");
   run_free(&r);
   free(pts);
 }
