@@ -29,7 +29,8 @@
  *            the amplitude above warn_amplitude_fraction of the edge. Do not accelerate; reduce speed by the margin.
  *   WATCH    the speed within watch_speed_margin_kmh of the Hopf interval, or the vehicle not behaving like its
  *            model (the model-based and model-free Hopf speeds disagree), or the sensor at another rate than
- *            configured. No action; have the wheels' conicity or the sensor checked at the next stop.
+ *            configured, or partly blind (more than blind_fraction of the last 10 s of samples lost, estimator.h).
+ *            No action; have the wheels' conicity or the sensor checked at the next stop.
  *   OK       normal running. The bistable band (a large disturbance could start flange-contact hunting above the
  *            lowest cycle speed, docs/MODEL.md section 7) is stated in the status fields, not as a level: on good track
  *            at service speed it is permanent and a level that never changes tells a driver nothing.
@@ -83,7 +84,8 @@ typedef enum {
   HM_REASON_MODEL_MISMATCH = 12,    /* WATCH: model-based and model-free Hopf speeds disagree */
   HM_REASON_RATE_MISMATCH = 13,     /* WATCH: the sensor delivers another rate than configured */
   HM_REASON_BAD_SAMPLE_RATE = 14,   /* NO_DATA: a sample rate the filters cannot be designed for */
-  HM_REASON_DISPLACEMENT_CRITERION = 15 /* ALARM: the displacement amplitude at or above its limit (any frequency) */
+  HM_REASON_DISPLACEMENT_CRITERION = 15, /* ALARM: the displacement amplitude at or above its limit (any frequency) */
+  HM_REASON_PARTLY_BLIND = 16       /* WATCH: more than blind_fraction of the samples of the last 10 s were lost */
 } hm_reason;
 
 const char *hm_level_name(hm_level level);   /* "NO_DATA", "OK", ... */
@@ -103,6 +105,7 @@ typedef struct {
   double conicity_prior_high;           /* hold the fallback; 0: the fallback -+ HM_ALARM_PRIOR_HALFWIDTH */
   double release_s;                     /* an oscillation ALARM is released after this long calm [s] */
   double release_amplitude_fraction;    /* calm: displacement below this fraction of the displacement limit */
+  double blind_fraction;                /* WATCH "partly blind" above this fraction of samples lost over 10 s */
 } hm_alarm_config;
 
 /* The prior's default half-width: new to worn wheels of a high-speed fleet move lambda(0) by about this (the default

@@ -45,7 +45,8 @@
  * invalid.
  * Lost samples: when a block's stamps are regular (95% of the differences within 0.25 periods of a whole number of
  * median differences: a sensor's own clock; receipt times in bursts are not) at a rate within 5% of the design, a
- * difference of k >= 2 periods (up to max_gap_s) counts k - 1 lost samples (n_samples_lost; loss_fraction over about
+ * difference of k >= 2 periods (up to max_gap_s: a link dropping 60 ms once a second neither restarts the filters,
+ * the r.m.s. window nor the identification) counts k - 1 lost samples (n_samples_lost; loss_fraction over about
  * the last 10 s) and is bridged by k - 1 linearly interpolated samples, so the filters, trackers and criteria stay on
  * their time grid (hm_estimator_last_fill tells a consumer of the same stream how many).
  * Bad input is counted and skipped, never propagated: non-finite or implausibly large samples, repeated or
@@ -95,7 +96,7 @@ typedef struct {
 } hm_estimator_config;
 
 /* Defaults (config/monitor.yaml cites their sources): wheelset, 2 kHz, band 2-20 Hz, tracking 1 s, r.m.s. over 100 m
- * against 12 m/s^2, 6 peaks of 17 m/s^2 in 2-20 Hz, gaps > 0.05 s, stale after 0.2 s (acceleration) / 1 s (speed),
+ * against 12 m/s^2, 6 peaks of 17 m/s^2 in 2-20 Hz, gaps > 0.2 s (shorter ones on a regular grid are bridged), stale after 0.2 s (acceleration) / 1 s (speed),
  * speed <= 600 km/h changing <= 30 km/h per second (plus 2 km/h of sensor noise), samples <= 500 m/s^2. */
 void hm_estimator_config_default(hm_estimator_config *cfg);
 /* The criteria's limits and bands for a measurement point (see above); the other fields are left as they are. */

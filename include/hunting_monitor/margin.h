@@ -101,6 +101,9 @@ typedef enum {
                                (monitor.h) */
 } hm_window_verdict;
 
+/* A short English sentence for a verdict; never NULL. */
+const char *hm_window_verdict_text(hm_window_verdict verdict);
+
 typedef struct hm_margin_s *hm_margin;
 
 /* For a vehicle (its linear model is inverted). HM_EDOMAIN (reason in why) for a bad configuration or vehicle. */

@@ -63,6 +63,8 @@ typedef struct {
   double mode_speed_kmh;       /* mean speed over its window */
   double mode_speed_spread_kmh;/* and its range */
   hm_window_verdict mode_verdict; /* whether the margin used that window */
+  int mode_steady;             /* mode.valid and its window was at a steady speed, without a criterion met: the
+                                  decay rate means what it says (a fit over a changing speed is shown as not valid) */
   double line_wavelength_m;    /* a periodic excitation in that window (mode.lines_found): V / f1 [m]; 0 if none */
   hm_margin_estimate margin;   /* conicity, Hopf speed model-based and model-free, mismatch */
   hm_assessment assessment;    /* level, reason, boundaries and margins */

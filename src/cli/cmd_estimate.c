@@ -64,7 +64,8 @@ static void write_line(const hm_monitor_status *st, double t) {
   jw_number(&w, "frequency_hz", e->frequency_hz);
   jw_number(&w, "amplitude_m", e->amplitude_displacement_m);
   /* the identified hunting mode (the latest window) */
-  jw_bool(&w, "mode_valid", md->valid);
+  jw_bool(&w, "mode_valid", st->mode_steady);
+  jw_bool(&w, "mode_fit_valid", md->valid);
   jw_number(&w, "mode_frequency_hz", md->valid ? md->frequency_hz : NAN);
   jw_number(&w, "mode_frequency_se_hz", md->valid ? md->frequency_se_hz : NAN);
   jw_number(&w, "decay_rate_1_s", md->valid ? md->decay_rate_1_s : NAN);
@@ -74,6 +75,7 @@ static void write_line(const hm_monitor_status *st, double t) {
   jw_number(&w, "mode_speed_kmh", md->valid ? st->mode_speed_kmh : NAN);
   jw_number(&w, "mode_speed_spread_kmh", md->valid && st->mode_speed_spread_kmh >= 0.0 ? st->mode_speed_spread_kmh : NAN);
   jw_int(&w, "mode_window_verdict", (long)st->mode_verdict);
+  jw_string(&w, "mode_window_verdict_text", hm_window_verdict_text(st->mode_verdict));
   /* a periodic excitation of the track found in the latest window (its bins left out of the fit) */
   jw_bool(&w, "lines_found", md->lines_found);
   jw_number(&w, "line_fundamental_hz", md->lines_found ? md->line_fundamental_hz : NAN);

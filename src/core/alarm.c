@@ -58,6 +58,7 @@ const char *hm_reason_text(hm_reason r) {
     case HM_REASON_RATE_MISMATCH: return "the sensor delivers another sample rate than configured";
     case HM_REASON_BAD_SAMPLE_RATE: return "acceleration at a sample rate the filters cannot use";
     case HM_REASON_DISPLACEMENT_CRITERION: return "displacement amplitude criterion exceeded";
+    case HM_REASON_PARTLY_BLIND: return "partly blind: samples of the last 10 s lost";
   }
   return "?";
 }
@@ -76,6 +77,7 @@ void hm_alarm_config_default(hm_alarm_config *c) {
   c->conicity_prior_high = 0.0;
   c->release_s = 10.0;
   c->release_amplitude_fraction = 0.5;
+  c->blind_fraction = 0.2;
 }
 
 hm_status hm_alarm_config_validate(const hm_alarm_config *c, char *why, size_t len) {
@@ -104,6 +106,8 @@ hm_status hm_alarm_config_validate(const hm_alarm_config *c, char *why, size_t l
     field = "conicity_prior_low", rule = "must be in [0, 10]", got = c->conicity_prior_low;
   else if (!(c->conicity_prior_high >= 0.0 && c->conicity_prior_high <= 10.0))
     field = "conicity_prior_high", rule = "must be in [0, 10]", got = c->conicity_prior_high;
+  else if (!(c->blind_fraction > 0.0 && c->blind_fraction <= 1.0))
+    field = "blind_fraction", rule = "must be in (0, 1]", got = c->blind_fraction;
   else if (!(c->release_s >= 0.0 && c->release_s <= 3600.0))
     field = "release_s", rule = "must be in [0, 3600]", got = c->release_s;
   else if (!(c->release_amplitude_fraction > 0.0 && c->release_amplitude_fraction <= 1.0))
@@ -242,6 +246,7 @@ static hm_level raw_level(const hm_alarm a, const hm_estimate *e, const hm_margi
     return *reason = HM_REASON_APPROACHING_HOPF, HM_LEVEL_WATCH;
   if (g && g->model_mismatch) return *reason = HM_REASON_MODEL_MISMATCH, HM_LEVEL_WATCH;
   if (e->sample_rate_mismatch) return *reason = HM_REASON_RATE_MISMATCH, HM_LEVEL_WATCH;
+  if (e->loss_fraction > c->blind_fraction) return *reason = HM_REASON_PARTLY_BLIND, HM_LEVEL_WATCH;
   if (v < s->boundaries.lowest_cycle_speed_kmh) return *reason = HM_REASON_BELOW_LOWEST_CYCLE, HM_LEVEL_OK;
   return *reason = HM_REASON_NORMAL, HM_LEVEL_OK;
 }

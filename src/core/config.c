@@ -351,6 +351,7 @@ static const settings_field alarm_fields[] = {
     ALM(conicity_max_se, FIELD_DOUBLE),         ALM(conicity_fallback, FIELD_DOUBLE),
     ALM(conicity_prior_low, FIELD_DOUBLE),      ALM(conicity_prior_high, FIELD_DOUBLE),
     ALM(release_s, FIELD_DOUBLE),               ALM(release_amplitude_fraction, FIELD_DOUBLE),
+    ALM(blind_fraction, FIELD_DOUBLE),
 };
 
 static const settings_field table_fields[] = {

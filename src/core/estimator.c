@@ -85,7 +85,7 @@ void hm_estimator_config_default(hm_estimator_config *c) {
   c->tracking_time_s = 1.0;
   c->rms_window_m = 100.0;
   hm_estimator_config_criteria(c, HM_POINT_WHEELSET);
-  c->max_gap_s = 0.05;
+  c->max_gap_s = 0.2;
   c->accel_timeout_s = 0.2;
   c->speed_timeout_s = 1.0;
   c->max_speed_kmh = 600.0;

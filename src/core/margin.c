@@ -36,6 +36,21 @@ struct hm_margin_s {
   double last_change_s;
 };
 
+const char *hm_window_verdict_text(hm_window_verdict v) {
+  switch (v) {
+    case HM_WINDOW_USED: return "used";
+    case HM_WINDOW_MODE_INVALID: return "no mode identified";
+    case HM_WINDOW_SPEED_VARIED: return "the speed varied: shown, not used";
+    case HM_WINDOW_TOO_SLOW: return "below the margin's minimum speed";
+    case HM_WINDOW_OVERLAPS: return "overlaps a window already used";
+    case HM_WINDOW_NO_INVERSION: return "no conicity explains it";
+    case HM_WINDOW_MISFIT: return "the model cannot explain its decay rate and frequency together";
+    case HM_WINDOW_CHANGE: return "the conicity changed: the windows held were dropped";
+    case HM_WINDOW_NONLINEAR: return "a criterion was met during it: hunting is not the linear mode";
+  }
+  return "?";
+}
+
 void hm_margin_config_default(hm_margin_config *c) {
   c->frequency_model_error = 0.01;
   c->decay_rate_model_error = 0.10;

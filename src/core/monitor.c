@@ -136,6 +136,7 @@ hm_status hm_monitor_create_parallel(const hm_monitor_config *cfg, const hm_vehi
   }
   hm_alarm_set_displacement_limit(m->alarm, cfg->estimator.displacement_limit_m);
   m->modal_ok = 1;
+  m->verdict = HM_WINDOW_MODE_INVALID; /* no fit yet */
   m->large_at = -INFINITY;
   m->conicity_in_use = NAN;
   m->refine_failed_at = NAN;
@@ -163,6 +164,7 @@ void hm_monitor_reset(hm_monitor m) {
   m->restarts = hm_estimator_restarts(m->est, &m->rate_hz);
   m->have_speed = 0;
   memset(&m->mode, 0, sizeof m->mode);
+  m->verdict = HM_WINDOW_MODE_INVALID;
   hm_margin_reset(m->margin); /* its windows' times are on the old time line */
   m->large_at = -INFINITY;
   restart_stream(m);
@@ -284,6 +286,7 @@ hm_status hm_monitor_update(hm_monitor m, double now, hm_monitor_status *out) {
   s.mode_speed_kmh = m->mode_speed;
   s.mode_speed_spread_kmh = isfinite(m->mode_spread) ? m->mode_spread : -1.0;
   s.mode_verdict = m->verdict;
+  s.mode_steady = m->mode.valid && m->verdict != HM_WINDOW_SPEED_VARIED && m->verdict != HM_WINDOW_NONLINEAR;
   s.line_wavelength_m = m->mode.lines_found && m->mode.line_fundamental_hz > 0.0
                             ? hm_mps_from_kmh(m->mode_speed) / m->mode.line_fundamental_hz
                             : 0.0;

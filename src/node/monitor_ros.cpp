@@ -263,7 +263,11 @@ void MonitorRos::onTimer(const ros::TimerEvent&) {
   const ros::Time now = ros::Time::now();
   checkRosTime(now);
   hm_monitor_status st;
-  if (hm_monitor_update(monitor_, now.toSec(), &st) != HM_OK) return;
+  const hm_status ust = hm_monitor_update(monitor_, now.toSec(), &st);
+  if (ust != HM_OK) {
+    publishFailure(ust, now);
+    return;
+  }
   refineTable();
   last_ = st;
   have_last_ = true;
@@ -287,13 +291,16 @@ void MonitorRos::onTimer(const ros::TimerEvent&) {
   m.sample_rate_mismatch = e.sample_rate_mismatch;
   m.samples_lost = e.n_samples_lost;
   m.samples_lost_fraction = finite(e.loss_fraction);
-  m.mode_valid = md.valid;
-  m.mode_frequency_hz = md.valid ? finite(md.frequency_hz) : 0.0;
-  m.mode_frequency_se_hz = md.valid ? finite(md.frequency_se_hz) : 0.0;
-  m.decay_rate_1_s = md.valid ? finite(md.decay_rate_1_s) : 0.0;
-  m.decay_rate_se_1_s = md.valid ? finite(md.decay_rate_se_1_s) : 0.0;
-  m.damping_ratio = md.valid ? finite(md.damping_ratio) : 0.0;
-  m.damping_ratio_se = md.valid ? finite(md.damping_ratio_se) : 0.0;
+  m.mode_valid = st.mode_steady;  // a fit over a changing speed is not the mode's damping at a speed
+  m.mode_verdict = static_cast<uint8_t>(st.mode_verdict);
+  m.mode_verdict_text = hm_window_verdict_text(st.mode_verdict);
+  const bool mv = m.mode_valid;
+  m.mode_frequency_hz = mv ? finite(md.frequency_hz) : 0.0;
+  m.mode_frequency_se_hz = mv ? finite(md.frequency_se_hz) : 0.0;
+  m.decay_rate_1_s = mv ? finite(md.decay_rate_1_s) : 0.0;
+  m.decay_rate_se_1_s = mv ? finite(md.decay_rate_se_1_s) : 0.0;
+  m.damping_ratio = mv ? finite(md.damping_ratio) : 0.0;
+  m.damping_ratio_se = mv ? finite(md.damping_ratio_se) : 0.0;
   m.windows_used = g.n_windows;
   m.track_lines_found = md.lines_found;
   m.track_line_wavelength_m = md.lines_found ? finite(st.line_wavelength_m) : 0.0;
@@ -369,6 +376,25 @@ void MonitorRos::onTimer(const ros::TimerEvent&) {
   updater_.update();
 }
 
+void MonitorRos::publishFailure(hm_status st, const ros::Time& now) {
+  hunting_monitor::HuntingStatus m;  // every field 0 / false: nothing is current
+  m.header.stamp = now;
+  m.header.frame_id = frame_id_;
+  m.level = HM_LEVEL_NO_DATA;
+  m.reason_code = HM_REASON_STARTUP;
+  m.reason = std::string("the monitor could not update: ") + hm_status_str(st);
+  status_pub_.publish(m);
+  if (last_published_level_ != HM_LEVEL_NO_DATA) {
+    std_msgs::UInt8 level;
+    level.data = HM_LEVEL_NO_DATA;
+    alarm_pub_.publish(level);
+    last_published_level_ = HM_LEVEL_NO_DATA;
+  }
+  have_last_ = false;  // the diagnostics say "no data" rather than show the last good status as current
+  ROS_ERROR_THROTTLE(5.0, "hunting_monitor: %s", m.reason.c_str());
+  updater_.update();
+}
+
 void MonitorRos::publishMarkers(const hm_monitor_status& st, const ros::Time& now) {
   const hm_estimate& e = st.estimate;
   const hm_assessment& s = st.assessment;
@@ -396,7 +422,7 @@ void MonitorRos::publishMarkers(const hm_monitor_status& st, const ros::Time& no
   text.scale.z = 0.16;
   text.color.r = text.color.g = text.color.b = 1.0;
   char buf[512], decay[32] = "-";
-  if (st.mode.valid) std::snprintf(decay, sizeof decay, "%.2f 1/s", st.mode.decay_rate_1_s);
+  if (st.mode_steady) std::snprintf(decay, sizeof decay, "%.2f 1/s", st.mode.decay_rate_1_s);
   if (s.boundaries_valid)
     std::snprintf(buf, sizeof buf,
                   "%s: %s\nV %.1f km/h  Hopf %.1f [%.1f, %.1f] (%s)  lowest cycle %.1f\n"
@@ -475,7 +501,8 @@ void MonitorRos::diagnoseLevel(diagnostic_updater::DiagnosticStatusWrapper& stat
   const hm_margin_estimate& g = last_.margin;
   if (have_last_) {
     stat.add("identified windows", g.n_windows);
-    if (last_.mode.valid) {
+    stat.add("identification window", std::string(hm_window_verdict_text(last_.mode_verdict)));
+    if (last_.mode_steady) {
       stat.add("decay rate [1/s]", last_.mode.decay_rate_1_s);
       stat.add("damping ratio", last_.mode.damping_ratio);
     }

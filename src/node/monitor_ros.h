@@ -45,6 +45,8 @@ class MonitorRos {
   void onTimer(const ros::TimerEvent& ev);
   void refineTable();
   void publishMarkers(const hm_monitor_status& st, const ros::Time& now);
+  // An update that failed still gives a status (NO_DATA, the reason in words) and the alarm level NO_DATA.
+  void publishFailure(hm_status st, const ros::Time& now);
   void diagnoseInputs(diagnostic_updater::DiagnosticStatusWrapper& stat);
   void diagnoseLevel(diagnostic_updater::DiagnosticStatusWrapper& stat);
   void diagnoseTable(diagnostic_updater::DiagnosticStatusWrapper& stat);

@@ -144,22 +144,25 @@ class Robustness(unittest.TestCase):
             time.sleep(2.0)
             start = time.time()
             k = 0
-            while time.time() - start < 4.0:
+
+            def done():  # a settled 10 Hz tone and the exact family added (the node's table refinement)
+                return got and got[-1].oscillation_valid and abs(got[-1].frequency_hz - 10.0) < 0.3 and \
+                    got[-1].table_conicities == 37
+            # at least 4 s; on a loaded machine this Python publisher stalls (beyond 50 ms it is a gap and the
+            # tracker settles again), so it streams until the status shows it settled, 20 s at most
+            while time.time() - start < 4.0 or (not done() and time.time() - start < 20.0):
                 acc.publish(Float64(2.0 * math.sin(2 * math.pi * 10.0 * (time.time() - start))))
                 if k % 20 == 0:
                     spd.publish(Float64(100.0))  # m/s = 360 km/h
                 k += 1
                 time.sleep(0.005)
             self.assertTrue(got, "no status from the float64/m/s node")
-            last = got[-1]
+            # the status that showed it (a later one, within 5 ms, may come from a new stall)
+            last = next((m for m in reversed(got) if m.oscillation_valid and m.table_conicities == 37), got[-1])
             self.assertAlmostEqual(last.speed_kmh, 360.0, places=6)
             self.assert_normal(last, got)
-            # the tone's frequency from the receipt times (a status of the last 1.5 s with the tracker settled: a stall
-            # of this Python publisher beyond 50 ms on a loaded machine is a gap, and the tracker settles again)
-            recent = [m for m in got if m.header.stamp.to_sec() >= last.header.stamp.to_sec() - 1.5]
-            settled = [m for m in recent if m.oscillation_valid]
-            self.assertTrue(settled, [(m.oscillation_valid, m.frequency_hz) for m in recent[-5:]])
-            self.assertLess(abs(settled[-1].frequency_hz - 10.0), 0.3, settled[-1].frequency_hz)
+            self.assertTrue(last.oscillation_valid and abs(last.frequency_hz - 10.0) < 0.3,
+                            (last.oscillation_valid, last.frequency_hz, time.time() - start))
             first = next(m for m in got if m.boundaries_valid)
             self.assertEqual(first.table_conicities, 36)  # the computed table (hm_monitor_config_default)
             self.assertGreater(first.table_error_speed_kmh, 0.05)  # interpolated at 0.1358: beyond the tolerance

@@ -300,6 +300,19 @@ static void levels_with_a_conicity_estimate(void) {
   HM_CHECK(hm_alarm_update(a, &e, &g, 0.0, &s) == HM_OK && s.level == HM_LEVEL_WATCH &&
                s.reason == HM_REASON_RATE_MISMATCH,
            "rate: %s", hm_reason_text(s.reason));
+  /* partly blind: a third of the last 10 s of samples lost (bridged gaps) is WATCH; a tenth is not */
+  hm_alarm_destroy(a);
+  a = make();
+  e = estimate(400.0, 0.0);
+  e.loss_fraction = 0.3;
+  HM_CHECK(hm_alarm_update(a, &e, &g, 0.0, &s) == HM_OK && s.level == HM_LEVEL_WATCH &&
+               s.reason == HM_REASON_PARTLY_BLIND,
+           "blind: %s", hm_reason_text(s.reason));
+  hm_alarm_destroy(a);
+  a = make();
+  e.loss_fraction = 0.1;
+  HM_CHECK(hm_alarm_update(a, &e, &g, 0.0, &s) == HM_OK && s.level == HM_LEVEL_OK, "10%% lost: %s",
+           hm_level_name(s.level));
   e.sample_rate_supported = 0;
   e.accel_valid = 0;
   HM_CHECK(hm_alarm_update(a, &e, &g, 0.1, &s) == HM_OK && s.level == HM_LEVEL_NO_DATA &&

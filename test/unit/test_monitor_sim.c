@@ -281,7 +281,8 @@ static void decay_rate_on_our_simulator(void) {
       run_init(&r, speeds[i], scales[i], (uint64_t)(100 + seed), (uint64_t)seed);
       run_segment(&r, 45.0);
       const hm_mode_estimate *m = &r.last.mode;
-      HM_CHECK(m->valid, "V %g seed %d: no mode", speeds[i], seed);
+      HM_CHECK(m->valid && r.last.mode_steady, "V %g seed %d: no mode (steady %d)", speeds[i], seed,
+               r.last.mode_steady);
       HM_CHECK_DELTA(m->decay_rate_1_s, re[0], fmax(0.25 * fabs(re[0]), 0.3), "decay rate");
       lo = fmin(lo, m->decay_rate_1_s);
       hi = fmax(hi, m->decay_rate_1_s);
@@ -292,6 +293,33 @@ static void decay_rate_on_our_simulator(void) {
     }
     printf("  %.0f km/h: decay rate %.3f..%.3f 1/s over %d seeds, model %.3f 1/s\n", speeds[i], lo, hi, n_seeds, re[0]);
   }
+}
+
+/* A fit over a changing speed is shown, not valid (issue #21): on a ramp 470 -> 500 km/h over 40 s the windows'
+ * speed varies beyond max_speed_spread_kmh, so the verdict is HM_WINDOW_SPEED_VARIED and mode_steady is 0 even where
+ * the fit itself converged; the margin holds no window and the interval is the prior's. */
+static void ramp_fits_are_not_valid_modes(void) {
+  run_state r;
+  run_init(&r, 470.0, 0.1, 7, 7);
+  hm_sensor_sim_destroy(r.sim);
+  hm_sensor_sim_config sc;
+  hm_sensor_sim_config_default(&sc);
+  sc.v_start_kmh = 470.0;
+  sc.v_end_kmh = 500.0;
+  sc.ramp_s = 40.0;
+  sc.irregularity_scale = 0.1;
+  sc.track_seed = sc.noise_seed = 7;
+  sc.speed_rate_hz = 50.0;
+  char why[256] = "";
+  HM_CHECK(hm_sensor_sim_create(&vehicle, &sc, NULL, &r.sim, why, sizeof why) == HM_OK, "simulation: %s", why);
+  run_segment(&r, 38.0);
+  printf("  ramp 470 -> 500 km/h: fit converged %d, verdict %d (%s), steady %d, %u windows held\n", r.last.mode.valid,
+         (int)r.last.mode_verdict, hm_window_verdict_text(r.last.mode_verdict), r.last.mode_steady,
+         r.last.margin.n_windows);
+  HM_CHECK(r.last.mode_verdict == HM_WINDOW_SPEED_VARIED && !r.last.mode_steady && r.last.margin.n_windows == 0 &&
+               r.last.assessment.conicity_from_prior,
+           "a ramp's fit taken as the mode: verdict %d, steady %d", (int)r.last.mode_verdict, r.last.mode_steady);
+  run_free(&r);
 }
 
 int main(int argc, char **argv) {
@@ -311,6 +339,7 @@ int main(int argc, char **argv) {
   HM_RUN(table_refined_at_the_conicity_in_use);
   HM_RUN(settings_changed_while_running);
   HM_RUN(decay_rate_on_our_simulator);
+  HM_RUN(ramp_fits_are_not_valid_modes);
   free(table_text);
   HM_TEST_EXIT();
 }
