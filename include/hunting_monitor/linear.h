@@ -45,6 +45,12 @@ hm_status hm_linear_spectral_abscissa(const hm_vehicle *veh, double conicity, do
  * or unstable at every speed (a4 <= 0 or a2 <= 0). */
 hm_status hm_linear_critical_speed(const hm_vehicle *veh, double conicity, double *speed_mps);
 
+/* The reported Hopf speed [km/h] where the linear model is stable at every speed (or the conicity is not > 0). */
+#define HM_LINEAR_NO_HOPF_KMH 1e4
+/* The closed-form critical speed in km/h, capped at HM_LINEAR_NO_HOPF_KMH, which it also is where there is none
+ * (the margin and the alarm report Hopf speeds so). Never fails, never NaN. */
+double hm_linear_hopf_kmh(const hm_vehicle *veh, double conicity);
+
 /* Closed-form critical conicity at speed v [m/s]; HM_ENOCRIT if no conicity >= 0 is stable there. */
 hm_status hm_linear_critical_conicity(const hm_vehicle *veh, double speed_mps, double *conicity);
 

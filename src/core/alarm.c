@@ -8,9 +8,6 @@
 
 #include "hunting_monitor/linear.h"
 
-/* The Hopf speed reported where the linear model is stable at every speed (as margin.c). */
-static const double NO_HOPF_KMH = 1e4;
-
 struct hm_alarm_s {
   hm_alarm_config cfg;            /* fallback and prior resolved for the vehicle */
   hm_vehicle veh;
@@ -121,12 +118,6 @@ hm_status hm_alarm_config_validate(const hm_alarm_config *c, char *why, size_t l
   return HM_EDOMAIN;
 }
 
-static double hopf_kmh(const hm_vehicle *veh, double conicity) {
-  double v_mps;
-  if (!(conicity > 0.0) || hm_linear_critical_speed(veh, conicity, &v_mps) != HM_OK) return NO_HOPF_KMH;
-  return fmin(hm_kmh_from_mps(v_mps), NO_HOPF_KMH);
-}
-
 /* The configuration with the fallback and the prior resolved for the vehicle, and the prior's Hopf speeds; HM_EDOMAIN
  * (reason in why) for a prior that does not hold the fallback. */
 static hm_status resolve(const hm_alarm_config *cfg, const hm_vehicle *veh, hm_alarm_config *out, double *hopf_low,
@@ -146,8 +137,8 @@ static hm_status resolve(const hm_alarm_config *cfg, const hm_vehicle *veh, hm_a
     return HM_EDOMAIN;
   }
   *out = c;
-  *hopf_low = hopf_kmh(veh, c.conicity_prior_high);
-  *hopf_high = hopf_kmh(veh, c.conicity_prior_low);
+  *hopf_low = hm_linear_hopf_kmh(veh, c.conicity_prior_high);
+  *hopf_high = hm_linear_hopf_kmh(veh, c.conicity_prior_low);
   return HM_OK;
 }
 
@@ -261,7 +252,7 @@ static hm_status lookup(hm_alarm a, int k, double conicity, double speed_kmh, hm
   hm_table_lookup_result r;
   const hm_status st = hm_table_lookup(a->table, conicity, speed_kmh, &r);
   if (st != HM_OK) return st;
-  if (r.conicity != conicity) r.hopf_speed_kmh = hopf_kmh(&a->veh, conicity);
+  if (r.conicity != conicity) r.hopf_speed_kmh = hm_linear_hopf_kmh(&a->veh, conicity);
   a->cache[k].valid = 1;
   a->cache[k].conicity = conicity;
   a->cache[k].speed_kmh = speed_kmh;
@@ -289,7 +280,7 @@ static hm_status assess(hm_alarm a, const hm_estimate *e, const hm_margin_estima
     hi = g->hopf_model_high_kmh;
     s->conicity_se = g->conicity_se;
   } else if (have) {
-    if (g->hopf_model_kmh < hopf_kmh(&a->veh, lambda)) lambda = g->conicity, s->conicity_se = g->conicity_se;
+    if (g->hopf_model_kmh < hm_linear_hopf_kmh(&a->veh, lambda)) lambda = g->conicity, s->conicity_se = g->conicity_se;
     lo = fmin(lo, g->hopf_model_low_kmh);
     if (g->hopf_model_high_kmh < hi) hi = g->hopf_model_high_kmh, lambda_opt = g->conicity_low;
   }

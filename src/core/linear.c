@@ -105,6 +105,13 @@ hm_status hm_linear_spectral_abscissa(const hm_vehicle *veh, double conicity, do
   return HM_OK;
 }
 
+double hm_linear_hopf_kmh(const hm_vehicle *veh, double conicity) {
+  double v_mps;
+  if (!veh || !(conicity > 0.0) || hm_linear_critical_speed(veh, conicity, &v_mps) != HM_OK)
+    return HM_LINEAR_NO_HOPF_KMH;
+  return fmin(hm_kmh_from_mps(v_mps), HM_LINEAR_NO_HOPF_KMH);
+}
+
 hm_status hm_linear_critical_speed(const hm_vehicle *veh, double conicity, double *speed_mps) {
   hurwitz_terms h;
   hm_status st = terms_of(veh, conicity, &h);

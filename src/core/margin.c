@@ -9,7 +9,7 @@
 #include "hunting_monitor/linear.h"
 
 /* The Hopf speed reported when the linear model is stable at every speed at a conicity. */
-static const double NO_HOPF_KMH = 1e4;
+static const double NO_HOPF_KMH = HM_LINEAR_NO_HOPF_KMH;
 
 typedef struct {
   double t_end_s, speed_kmh;
@@ -117,9 +117,7 @@ void hm_margin_reset(hm_margin m) {
 }
 
 double hm_margin_hopf_kmh(const hm_margin m, double conicity) {
-  double v_mps;
-  if (!m || !(conicity > 0.0) || hm_linear_critical_speed(&m->veh, conicity, &v_mps) != HM_OK) return NO_HOPF_KMH;
-  return fmin(hm_kmh_from_mps(v_mps), NO_HOPF_KMH);
+  return m ? hm_linear_hopf_kmh(&m->veh, conicity) : NO_HOPF_KMH;
 }
 
 /* A window's checks and inversion into *w; the verdict says whether it can be used. */
