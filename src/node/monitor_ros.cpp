@@ -1,5 +1,6 @@
 #include "monitor_ros.h"
 
+#include <hunting_monitor/HuntingAlarm.h>
 #include <hunting_monitor/HuntingStatus.h>
 #include <std_msgs/UInt8.h>
 #include <visualization_msgs/MarkerArray.h>
@@ -34,6 +35,7 @@ MonitorRos::MonitorRos(ros::NodeHandle nh, ros::NodeHandle pnh)
   speed_sub_ = nh_.subscribe("speed", 100, &MonitorRos::onSpeed, this);
   status_pub_ = nh_.advertise<hunting_monitor::HuntingStatus>("hunting_status", 50);
   alarm_pub_ = nh_.advertise<std_msgs::UInt8>("hunting_alarm", 1, true);
+  alarm_stamped_pub_ = nh_.advertise<hunting_monitor::HuntingAlarm>("hunting_alarm_stamped", 1, true);
   marker_pub_ = nh_.advertise<visualization_msgs::MarkerArray>("hunting_markers", 5);
   chart_pub_ = nh_.advertise<visualization_msgs::MarkerArray>("hunting_chart", 5);
   chart_.reset(new StabilityChart(frame_id_));
@@ -94,11 +96,16 @@ bool MonitorRos::loadParameters() {
   pnh_.param("status_rate_hz", status_rate_hz_, 20.0);
   pnh_.param("bench_table_churn", bench_table_churn_, false);
   pnh_.param("allow_reconfigure", allow_reconfigure_, false);
-  pnh_.param("max_clock_offset_s", max_clock_offset_s_, 1.0);
-  if (!(max_clock_offset_s_ > 0.0 && max_clock_offset_s_ <= 3600.0)) {
-    ROS_FATAL("hunting_monitor: ~max_clock_offset_s must be in (0, 3600], got %g", max_clock_offset_s_);
+  hm_clock_config clock_cfg;
+  hm_clock_config_default(&clock_cfg);
+  pnh_.param("clock/window_s", clock_cfg.window_s, clock_cfg.window_s);
+  pnh_.param("clock/max_step_s", clock_cfg.max_step_s, clock_cfg.max_step_s);
+  pnh_.param("clock/confirm_s", clock_cfg.confirm_s, clock_cfg.confirm_s);
+  if (hm_clock_config_validate(&clock_cfg, err, sizeof err) != HM_OK) {
+    ROS_FATAL("hunting_monitor: ~%s", err);
     return false;
   }
+  hm_clock_init(&clock_, &clock_cfg);
   if (accel_type_ != "imu" && accel_type_ != "float64") {
     ROS_FATAL("hunting_monitor: ~accel_type must be imu or float64, got '%s'", accel_type_.c_str());
     return false;
@@ -209,29 +216,10 @@ void MonitorRos::checkRosTime(const ros::Time& now) {
     char what[160];
     std::snprintf(what, sizeof what, "ROS time moved backwards by %.3f s (a bag restarted or looped)",
                   last_ros_time_ - t);
-    stamp_offset_s_ = 0.0;
-    offset_since_ = -1.0;
+    hm_clock_reset(&clock_);
     timeJumped(what);
   }
   last_ros_time_ = t;
-}
-
-double MonitorRos::sensorTime(double stamp, double now) {
-  const double t = stamp - stamp_offset_s_;
-  if (std::fabs(t - now) <= max_clock_offset_s_) {
-    offset_since_ = -1.0;
-    return t;
-  }
-  ++dropped_offset_;
-  if (offset_since_ < 0.0) offset_since_ = now;
-  if (now - offset_since_ < 1.0) return NAN;  // a glitch, or a jump still to be confirmed
-  char what[160];
-  std::snprintf(what, sizeof what, "sensor stamps %.3f s from ROS time for 1 s (its clock jumped): re-anchored",
-                t - now);
-  stamp_offset_s_ = stamp - now;
-  offset_since_ = -1.0;
-  timeJumped(what);
-  return stamp - stamp_offset_s_;
 }
 
 void MonitorRos::pushAccel(double t, double a) {
@@ -247,23 +235,38 @@ void MonitorRos::onAccelFloat(const std_msgs::Float64::ConstPtr& msg) {
 void MonitorRos::onAccelImu(const sensor_msgs::Imu::ConstPtr& msg) {
   const ros::Time now = ros::Time::now();
   checkRosTime(now);
-  const double t = header_time_ ? sensorTime(msg->header.stamp.toSec(), now.toSec()) : now.toSec();
   const auto& a = msg->linear_acceleration;
-  if (std::isfinite(t)) pushAccel(t, axis_ == 0 ? a.x : axis_ == 1 ? a.y : a.z);
+  const double value = axis_ == 0 ? a.x : axis_ == 1 ? a.y : a.z;
+  if (!header_time_) {
+    pushAccel(now.toSec(), value);
+    return;
+  }
+  const double stamp = msg->header.stamp.toSec();
+  const double before = clock_.offset_s;
+  hm_clock_verdict v = HM_CLOCK_DROP;
+  if (hm_clock_observe(&clock_, stamp, now.toSec(), &v) != HM_OK || v == HM_CLOCK_DROP) return;
+  if (v == HM_CLOCK_STEPPED) {
+    char what[200];
+    std::snprintf(what, sizeof what,
+                  "sensor stamps %.3f s off their time line for %.1f s (its clock stepped): ROS time - stamp now %.3f s",
+                  clock_.offset_s - before, clock_.cfg.confirm_s, clock_.offset_s);
+    timeJumped(what);
+  }
+  pushAccel(stamp, value);
 }
 
 void MonitorRos::onSpeed(const std_msgs::Float64::ConstPtr& msg) {
   const double v = speed_unit_ == "mps" ? msg->data * 3.6 : msg->data;
   const ros::Time now = ros::Time::now();
   checkRosTime(now);
-  hm_monitor_push_speed(monitor_, now.toSec(), v);
+  hm_monitor_push_speed(monitor_, lineTime(now), v);  // no stamp in a Float64: its receipt, on the sensor's line
 }
 
 void MonitorRos::onTimer(const ros::TimerEvent&) {
   const ros::Time now = ros::Time::now();
   checkRosTime(now);
   hm_monitor_status st;
-  const hm_status ust = hm_monitor_update(monitor_, now.toSec(), &st);
+  const hm_status ust = hm_monitor_update(monitor_, lineTime(now), &st);
   if (ust != HM_OK) {
     publishFailure(ust, now);
     return;
@@ -279,7 +282,9 @@ void MonitorRos::onTimer(const ros::TimerEvent&) {
   hunting_monitor::HuntingStatus m;
   m.header.stamp = now;
   m.header.frame_id = frame_id_;
-  if (e.n_samples > 0) m.accel_stamp = ros::Time(e.time_s);
+  if (e.n_samples > 0) m.accel_stamp = ros::Time(rosTime(e.time_s));
+  m.sensor_clock_offset_s = clock_.have_offset ? clock_.offset_s : 0.0;
+  m.sensor_clock_steps = static_cast<uint32_t>(clock_.n_steps);
   m.level = static_cast<uint8_t>(s.level);
   m.reason_code = static_cast<uint8_t>(s.reason);
   m.reason = hm_reason_text(s.reason);
@@ -322,12 +327,12 @@ void MonitorRos::onTimer(const ros::TimerEvent&) {
   m.windows_birge_ratio = finite(g.birge_ratio);
   m.misfit_windows = g.n_misfits;
   m.conicity_changes = static_cast<uint32_t>(g.n_changes);
-  if (g.n_changes > 0) m.last_conicity_change = ros::Time(g.last_change_s);
+  if (g.n_changes > 0) m.last_conicity_change = ros::Time(rosTime(g.last_change_s));
   if (g.n_changes != last_changes_) {
     if (g.n_changes > last_changes_)
       ROS_WARN("hunting_monitor: the conicity changed (a window %.0f s ago disagreed with those held): the "
                "identification starts again from the next window, the prior's interval meanwhile",
-               now.toSec() - g.last_change_s);
+               lineTime(now) - g.last_change_s);
     last_changes_ = g.n_changes;
   }
   m.boundaries_valid = s.boundaries_valid;  // never a stale margin presented as current
@@ -362,11 +367,9 @@ void MonitorRos::onTimer(const ros::TimerEvent&) {
   m.criterion_displacement_exceeded = e.displacement_exceeded;
   status_pub_.publish(m);
 
-  if (static_cast<int>(s.level) != last_published_level_) {
-    std_msgs::UInt8 level;
-    level.data = static_cast<uint8_t>(s.level);
-    alarm_pub_.publish(level);
-    last_published_level_ = static_cast<int>(s.level);
+  publishLevel(s.level, s.reason, m.reason, s.latched, now);
+  if (static_cast<int>(s.level) != last_logged_level_) {
+    last_logged_level_ = static_cast<int>(s.level);
     ROS_INFO("hunting_monitor: level %s (%s) at %.1f km/h", hm_level_name(s.level), hm_reason_text(s.reason),
              e.speed_kmh);
   }
@@ -374,6 +377,30 @@ void MonitorRos::onTimer(const ros::TimerEvent&) {
   const visualization_msgs::MarkerArray chart = chart_->update(st, hm_monitor_table(monitor_), now);
   if (!chart.markers.empty()) chart_pub_.publish(chart);
   updater_.update();
+}
+
+void MonitorRos::publishLevel(hm_level level, hm_reason reason, const std::string& text, bool latched,
+                              const ros::Time& now) {
+  const bool changed = static_cast<int>(level) != last_published_level_;
+  if (changed) {
+    std_msgs::UInt8 bare;
+    bare.data = static_cast<uint8_t>(level);
+    alarm_pub_.publish(bare);
+    last_published_level_ = static_cast<int>(level);
+  }
+  if (changed || static_cast<int>(reason) != last_published_reason_ || now.toSec() - last_stamped_at_ >= 1.0 ||
+      now.toSec() < last_stamped_at_) {
+    hunting_monitor::HuntingAlarm a;
+    a.header.stamp = now;
+    a.header.frame_id = frame_id_;
+    a.level = static_cast<uint8_t>(level);
+    a.reason_code = static_cast<uint8_t>(reason);
+    a.reason = text;
+    a.level_latched = latched;
+    alarm_stamped_pub_.publish(a);
+    last_published_reason_ = static_cast<int>(reason);
+    last_stamped_at_ = now.toSec();
+  }
 }
 
 void MonitorRos::publishFailure(hm_status st, const ros::Time& now) {
@@ -384,12 +411,7 @@ void MonitorRos::publishFailure(hm_status st, const ros::Time& now) {
   m.reason_code = HM_REASON_STARTUP;
   m.reason = std::string("the monitor could not update: ") + hm_status_str(st);
   status_pub_.publish(m);
-  if (last_published_level_ != HM_LEVEL_NO_DATA) {
-    std_msgs::UInt8 level;
-    level.data = HM_LEVEL_NO_DATA;
-    alarm_pub_.publish(level);
-    last_published_level_ = HM_LEVEL_NO_DATA;
-  }
+  publishLevel(HM_LEVEL_NO_DATA, HM_REASON_STARTUP, m.reason, false, now);
   have_last_ = false;  // the diagnostics say "no data" rather than show the last good status as current
   ROS_ERROR_THROTTLE(5.0, "hunting_monitor: %s", m.reason.c_str());
   updater_.update();
@@ -477,7 +499,11 @@ void MonitorRos::diagnoseInputs(diagnostic_updater::DiagnosticStatusWrapper& sta
   stat.add("rejected speeds", e.n_speed_rejected);
   stat.add("time jumps", time_jumps_);
   stat.add("last time jump", last_jump_.empty() ? std::string("none") : last_jump_);
-  stat.add("samples dropped for clock offset", dropped_offset_);
+  stat.add("sensor clock offset (ROS time - stamp, least) [s]", clock_.have_offset ? clock_.offset_s : 0.0);
+  stat.add("latest sample's latency beyond the least [s]", clock_.latency_s);
+  stat.add("sensor clock steps", clock_.n_steps);
+  stat.add("samples dropped: stamped ahead of ROS time", clock_.n_dropped);
+  stat.add("samples received late (beyond max_step_s)", clock_.n_late);
   stat.add("oscillation valid", static_cast<bool>(e.oscillation_valid));
 }
 

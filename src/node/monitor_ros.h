@@ -17,6 +17,7 @@
 #include "table_refiner.h"
 
 extern "C" {
+#include "hunting_monitor/clock.h"
 #include "hunting_monitor/model.h"
 #include "hunting_monitor/monitor.h"
 }
@@ -36,15 +37,22 @@ class MonitorRos {
   void onAccelImu(const sensor_msgs::Imu::ConstPtr& msg);
   void onSpeed(const std_msgs::Float64::ConstPtr& msg);
   void pushAccel(double t, double a);
-  // Time that jumps: ROS time moving backwards (a bag restarted or looped) or a sensor's stamps far from ROS time
-  // (its clock jumped) restarts the monitor on the new time line; returns the time to use for a stamp (or NaN to
-  // drop the sample while a lasting offset is being confirmed).
+  // One time line (the core's clock.h): the monitor runs on the sensor's stamps; ROS times (the speed's receipt,
+  // now) are taken onto that line by the clock's offset, so staleness and the speed's pairing do not depend on the
+  // sensor clock's offset. Time that jumps restarts the monitor on the new line: ROS time moving backwards (a bag
+  // restarted or looped), or the sensor's clock stepping (the clock says so). With ~time_source receipt the stamps
+  // are ROS time and the offset 0.
   void checkRosTime(const ros::Time& now);
-  double sensorTime(double stamp, double now);
+  double lineTime(const ros::Time& now) { return hm_clock_to_sensor(&clock_, now.toSec()); }
   void timeJumped(const std::string& what);
   void onTimer(const ros::TimerEvent& ev);
   void refineTable();
   void publishMarkers(const hm_monitor_status& st, const ros::Time& now);
+  // The level on hunting_alarm (bare, on change) and hunting_alarm_stamped (on change of level or reason, and at
+  // least once a second).
+  void publishLevel(hm_level level, hm_reason reason, const std::string& text, bool latched, const ros::Time& now);
+  // ROS time of a time on the sensor's line.
+  double rosTime(double line_s) const { return line_s + (clock_.have_offset ? clock_.offset_s : 0.0); }
   // An update that failed still gives a status (NO_DATA, the reason in words) and the alarm level NO_DATA.
   void publishFailure(hm_status st, const ros::Time& now);
   void diagnoseInputs(diagnostic_updater::DiagnosticStatusWrapper& stat);
@@ -67,7 +75,8 @@ class MonitorRos {
   // last results, for diagnostics
   hm_monitor_status last_{};
   bool have_last_ = false;
-  int last_published_level_ = -1;
+  int last_published_level_ = -1, last_published_reason_ = -1, last_logged_level_ = -1;
+  double last_stamped_at_ = -1e300;  // ROS time hunting_alarm_stamped was last published
   unsigned long last_changes_ = 0;  // conicity changes the margin had detected at the last status (logged once each)
   // the table's refinement (the core says where, the worker computes, the callbacks never wait)
   std::unique_ptr<TableRefiner> refiner_;
@@ -76,17 +85,15 @@ class MonitorRos {
   std::string last_refine_error_;
   bool bench_table_churn_ = false;  // ~bench_table_churn: benchmarking only, a refinement every 0.5 s
   double churn_ = 0.0, next_churn_ = 0.0;
-  // time jumps
-  double max_clock_offset_s_ = 1.0;
+  // the sensor's clock against ROS time, and time jumps
+  hm_clock clock_{};
   double last_ros_time_ = 0.0;
-  double stamp_offset_s_ = 0.0;      // subtracted from sensor stamps after a re-anchoring
-  double offset_since_ = -1.0;       // ROS time since which stamps are off (negative: they are not)
-  unsigned long time_jumps_ = 0, dropped_offset_ = 0;
+  unsigned long time_jumps_ = 0;
   std::string last_jump_;
   double last_jump_at_ = -1e300;
   // ROS
   ros::Subscriber accel_sub_, speed_sub_;
-  ros::Publisher status_pub_, alarm_pub_, marker_pub_, chart_pub_;
+  ros::Publisher status_pub_, alarm_pub_, alarm_stamped_pub_, marker_pub_, chart_pub_;
   std::unique_ptr<StabilityChart> chart_;
   std::unique_ptr<SettingsReconfigure> reconfigure_;  // only with ~allow_reconfigure
   ros::Timer timer_;

@@ -89,7 +89,7 @@ class Robustness(unittest.TestCase):
         self.assert_normal(good[-1], self.latest(0.0))
         self.assertGreater(good[-1].sample_rate_hz, 100.0)
         t = rospy.Time.now().to_sec()
-        # right after good data, stamps 0.5 s in the past (within ~max_clock_offset_s, so they reach the estimator):
+        # right after good data, stamps 0.5 s in the past (within ~clock/max_step_s, so they reach the estimator):
         # out of order for their first half second; then NaN values
         self.stream(1.0, stamp_offset=-0.5)
         self.stream(1.0, value=float("nan"))
@@ -256,7 +256,7 @@ class Robustness(unittest.TestCase):
             ("bad_table", [("vehicle", "kx_mn_m", 9.7)], [], "table made for Kx 8.96"),
             ("bad_key", [("vehicle", "mas_kg", 1)], [], "vehicle.mas_kg: unknown key"),
             ("bad_time", [], ["_time_source:=gps"], "~time_source must be header or receipt"),
-            ("bad_offset", [], ["_max_clock_offset_s:=-1"], "~max_clock_offset_s must be in (0, 3600]"),
+            ("bad_clock", [], ["_clock/window_s:=-1"], "~clock.window_s: must be in (0, 3600]"),
         ]
         for name, changes, extra, message in cases:
             code, out = self.run_bad_node(name, changes, extra)

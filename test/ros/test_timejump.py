@@ -1,7 +1,8 @@
 #!/usr/bin/python3
 """Time that jumps: the node notices ROS time moving backwards (a restarted or looped bag) and a sensor clock jumping
 forwards, resets the monitor, says so in the log and diagnostics, and monitors again within its settling time (1 s
-tracking + 1 s rate measurement here), never stuck in NO_DATA."""
+tracking + 1 s rate measurement here), never stuck in NO_DATA. A sensor clock 0.6 s behind ROS time is monitored on
+one time line (clock.h): not stale, the offset in the status. The stamped level comes at least once a second."""
 import math
 import threading
 import time
@@ -10,7 +11,7 @@ import unittest
 import rospy
 import rostest
 from diagnostic_msgs.msg import DiagnosticArray
-from hunting_monitor.msg import HuntingStatus
+from hunting_monitor.msg import HuntingAlarm, HuntingStatus
 from rosgraph_msgs.msg import Clock
 from sensor_msgs.msg import Imu
 from std_msgs.msg import Float64
@@ -23,12 +24,13 @@ class TimeJump(unittest.TestCase):
     def setUpClass(cls):
         rospy.init_node("test_timejump")
         cls.lock = threading.Lock()
-        cls.status, cls.diag = [], []
+        cls.status, cls.diag, cls.alarms = [], [], []
         cls.clock = rospy.Publisher("/clock", Clock, queue_size=10)
         cls.accel = rospy.Publisher("accel", Imu, queue_size=1000)
         cls.speed = rospy.Publisher("speed", Float64, queue_size=10)
         rospy.Subscriber("hunting_status", HuntingStatus, cls.keep(cls.status), queue_size=1000)
         rospy.Subscriber("/diagnostics", DiagnosticArray, cls.keep(cls.diag), queue_size=100)
+        rospy.Subscriber("hunting_alarm_stamped", HuntingAlarm, cls.keep(cls.alarms), queue_size=100)
         cls.publish_clock(1000.0)
         time.sleep(2.0)  # connections
 
@@ -100,6 +102,35 @@ class TimeJump(unittest.TestCase):
         last = statuses[-1]
         self.assertAlmostEqual(last.speed_kmh, 400.0)
         self.assertTrue(last.oscillation_valid and abs(last.frequency_hz - 14.0) < 0.2, last.frequency_hz)
+        # ROS time - stamp: -3600 s plus the least latency (well under 50 ms here); in simulated time the node's
+        # clock may lag the stamps by a few /clock messages (2 ms each), so the least can be a little below -3600
+        self.assertTrue(-3600.02 <= last.sensor_clock_offset_s < -3600.0 + 0.05, last.sensor_clock_offset_s)
+        self.assertGreaterEqual(last.sensor_clock_steps, 1)
+
+    def test_2_sensor_clock_behind(self):
+        """From an hour ahead to 0.6 s behind ROS time (a step: the monitor restarts once), then on one time line:
+        monitoring, the offset +0.6 s plus the least latency, the newest sample's age on ROS time under 0.1 s; the
+        stamped level at least once a second of ROS time, its stamps those of statuses."""
+        mark = self.mark()
+        with self.lock:
+            n_alarms = len(self.alarms)
+        self.run_stream(509.0, 6.0, stamp_offset=-0.6)
+        statuses, diags = self.since(mark)
+        self.assert_monitoring_again(statuses, 509.0, 3.5)
+        last = statuses[-1]
+        self.assertTrue(0.58 <= last.sensor_clock_offset_s < 0.65, last.sensor_clock_offset_s)
+        age = (last.header.stamp - last.accel_stamp).to_sec()
+        self.assertTrue(-0.01 < age < 0.1, age)
+        self.assertTrue(last.oscillation_valid and abs(last.frequency_hz - 14.0) < 0.2, last.frequency_hz)
+        with self.lock:
+            alarms = self.alarms[n_alarms:]
+        stamps = sorted(a.header.stamp.to_sec() for a in alarms if a.header.stamp.to_sec() >= 509.0)
+        self.assertTrue(stamps and stamps[0] < 510.0 and stamps[-1] > 514.0, stamps[:3] + stamps[-3:])
+        gaps = [b - a for a, b in zip(stamps, stamps[1:])]
+        self.assertLessEqual(max(gaps), 1.06, gaps)
+        status_stamps = {round(m.header.stamp.to_sec(), 6) for m in statuses}
+        self.assertTrue(all(round(t, 6) in status_stamps for t in stamps), "a stamped level without its status")
+        self.assertEqual(alarms[-1].level, last.level)
 
 
 if __name__ == "__main__":
