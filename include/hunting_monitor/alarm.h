@@ -12,8 +12,10 @@
  *  - an estimate too uncertain to be used alone, or one of a vehicle that does not behave like its model
  *    (model_mismatch), is not replaced by the narrower prior: the level uses the more cautious of the two (the lower
  *    point, and the lower of each end);
- *  - with model_mismatch the model-free interval (margin.h), when valid, bounds the level as well (the lower of each
- *    end).
+ *  - the model-free interval (margin.h), when valid, bounds the level as well: its lower end with model_mismatch
+ *    or from HM_ALARM_FREE_MIN_WINDOWS windows on (a regression through two has no residual to check it: from 50 s
+ *    at 380 and 420 km/h its lower end lay 440-445 km/h on four runs of a vehicle whose Hopf speed is 473.8), its
+ *    upper end with model_mismatch (the lower of each end).
  * The table gives, at the conicity in use and the current speed, the lowest speed with a cycle, the unstable cycle
  * bounding the basin of the stable origin (the edge) and the stable cycle beyond it. Where the origin is unstable at
  * the conicity in use but the speed is still inside the Hopf interval, the edge is taken at the interval's
@@ -25,15 +27,23 @@
  *   ALARM    hunting or its onset: a criterion met (sliding r.m.s., consecutive peaks, with the limits of the
  *            measurement point; the displacement amplitude at any frequency of the band, estimator.h), the speed above the Hopf interval (the origin is unstable), or the displacement
  *            amplitude at or beyond the edge. Reduce speed now, below the lower end of the Hopf interval.
- *   WARN     close to the boundary: the speed inside the Hopf interval or within warn_speed_margin_kmh below it, or
- *            the amplitude above warn_amplitude_fraction of the edge. Do not accelerate; reduce speed by the margin.
- *   WATCH    the speed within watch_speed_margin_kmh of the Hopf interval, or the vehicle not behaving like its
+ *   WARN     close to the boundary: the speed at or above warn_from_kmh, inside the Hopf interval or within
+ *            warn_speed_margin_kmh below it (see below), or the amplitude above warn_amplitude_fraction of the edge.
+ *            Do not accelerate; reduce speed by the margin.
+ *   WATCH    the speed at or above watch_from_kmh (the same with watch_speed_margin_kmh), or the vehicle not behaving like its
  *            model (the model-based and model-free Hopf speeds disagree), or the sensor at another rate than
  *            configured, or partly blind (more than blind_fraction of the last 10 s of samples lost, estimator.h).
  *            No action; have the wheels' conicity or the sensor checked at the next stop.
  *   OK       normal running. The bistable band (a large disturbance could start flange-contact hunting above the
  *            lowest cycle speed, docs/MODEL.md section 7) is stated in the status fields, not as a level: on good track
  *            at service speed it is permanent and a level that never changes tells a driver nothing.
+ * The speed margins allow for the speed's own excursion and the driver's reaction. Below a range (the prior's Hopf
+ * speeds, the table's error, the more cautious of an estimate and the prior) they are added to its lower end: from
+ * hopf_low - margin. Below an identified interval, whose lower half-width h = point - hopf_low is interval_z standard
+ * errors of the Hopf speed, an error independent of the margin's allowance, the two add in quadrature: from
+ * point - sqrt(h^2 + margin^2) (h = 0: point - margin; margin 0: hopf_low). Added linearly they would count the
+ * estimate's uncertainty twice over: with 50 s at each of 380 and 420 km/h (h = 15-20 km/h), a WARN 28-33 km/h
+ * below the Hopf speed on a vehicle with conicity 0.16 (issue #18).
  * Thresholds of the current (or a higher) level are relaxed by the hysteresis (hysteresis_kmh on speeds,
  * hysteresis_amplitude_fraction of the edge on amplitudes), a higher level is taken at once, and a lower one only
  * after the conditions for it have held for min_hold_s: no chatter. Every change carries a reason code.
@@ -43,7 +53,12 @@
  * or of the edge where that limit is off) and the speed is below the lower end of the Hopf interval by the
  * hysteresis_kmh (the ALARM level's speed thresholds are relaxed by it, as everywhere); the status says
  * that the level is held and why (latched, release_in_s). A hunting wheelset's oscillation comes and goes with the
- * track; the driver's "reduce speed now" must not. A speed-only ALARM follows the speed with the hysteresis. Stale
+ * track; the driver's "reduce speed now" must not. While it is held, a criterion met at a speed below the Hopf
+ * interval brings the interval's lower end down to that speed (hopf_low_from_hunting): the vehicle hunted there,
+ * so its Hopf speed may be no higher (or it runs in the bistable band after a large disturbance), and the latch is
+ * released only below it (on issue #18's conicity step at 470 km/h the windows of the old conicity had held the
+ * interval at 492-579 km/h for a minute while the wheelset hunted at 470). A speed-only ALARM follows the speed with
+ * the hysteresis. Stale
  * input shows NO_DATA but keeps the latch: when data returns the ALARM is back until the calm is seen.
  */
 #ifndef HUNTING_MONITOR_ALARM_H
@@ -80,7 +95,7 @@ typedef enum {
   HM_REASON_AMPLITUDE_BEYOND_EDGE = 8, /* ALARM: amplitude at or beyond the unstable cycle */
   HM_REASON_RMS_CRITERION = 9,      /* ALARM: sliding r.m.s. above its limit */
   HM_REASON_PEAKS_CRITERION = 10,   /* ALARM: consecutive peaks above their limit */
-  HM_REASON_APPROACHING_HOPF = 11,  /* WATCH: within watch_speed_margin_kmh of the Hopf interval */
+  HM_REASON_APPROACHING_HOPF = 11,  /* WATCH: at or above watch_from_kmh (watch_speed_margin_kmh below the interval) */
   HM_REASON_MODEL_MISMATCH = 12,    /* WATCH: model-based and model-free Hopf speeds disagree */
   HM_REASON_RATE_MISMATCH = 13,     /* WATCH: the sensor delivers another rate than configured */
   HM_REASON_BAD_SAMPLE_RATE = 14,   /* NO_DATA: a sample rate the filters cannot be designed for */
@@ -93,8 +108,8 @@ const char *hm_reason_text(hm_reason reason); /* a short English sentence */
 
 typedef struct {
   double warn_amplitude_fraction;       /* WARN above this fraction of the edge amplitude */
-  double warn_speed_margin_kmh;         /* WARN within this below the Hopf interval */
-  double watch_speed_margin_kmh;        /* WATCH within this below the Hopf interval (>= the WARN margin) */
+  double warn_speed_margin_kmh;         /* WARN within this below the Hopf interval (in quadrature below an identified one) */
+  double watch_speed_margin_kmh;        /* WATCH within this below it (>= the WARN margin) */
   double hysteresis_kmh;
   double hysteresis_amplitude_fraction;
   double min_hold_s;                    /* a lower level needs its conditions this long */
@@ -111,6 +126,8 @@ typedef struct {
 /* The prior's default half-width: new to worn wheels of a high-speed fleet move lambda(0) by about this (the default
  * vehicle's measured 0.1358 to the issue's worn 0.16 is 0.024). */
 #define HM_ALARM_PRIOR_HALFWIDTH 0.03
+/* The model-free interval's lower end counts for the level from this many windows on (and with model_mismatch). */
+#define HM_ALARM_FREE_MIN_WINDOWS 3u
 
 /* Defaults: 0.5, 10 km/h, 30 km/h, 3 km/h, 0.1, 3 s, estimate used up to a standard error of 0.01, fallback 0
  * (the vehicle's), prior 0 / 0 (the fallback -+ 0.03), release after 10 s below half the displacement limit. */
@@ -129,6 +146,9 @@ typedef struct {
   int boundaries_valid;             /* 0 with NO_DATA: nothing below is current */
   hm_table_lookup_result boundaries;/* at the conicity in use and the current speed */
   double hopf_low_kmh, hopf_high_kmh; /* the Hopf interval the level uses */
+  double warn_from_kmh, watch_from_kmh; /* speeds from which the Hopf interval gives WARN and WATCH (no hysteresis) */
+  int hopf_low_from_hunting;        /* hopf_low_kmh is the lowest speed at which the held ALARM's oscillation met a
+                                       criterion (below the interval the estimate or prior gave) */
   double edge_used_m;               /* the edge amplitude the amplitude rules use (0: none) */
   double margin_hopf_kmh;           /* Hopf speed - speed */
   double margin_lowest_cycle_kmh;   /* lowest cycle speed - speed (negative: inside the bistable band) */

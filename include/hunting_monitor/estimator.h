@@ -69,6 +69,9 @@ extern "C" {
  * 5000 x 1000 m / (30 km/h) = 600,000 samples (9.6 MB), the crossing ring 20 x 2 x band_high_hz crossings. */
 #define HM_ESTIMATOR_MAX_TRACKING_S 20.0
 #define HM_ESTIMATOR_MAX_RMS_WINDOW_M 1000.0
+/* The wheelset's displacement criterion [m]: the criteria's amplitude at the default vehicle's hunting frequency
+ * (above: 12 m/s^2 r.m.s. and 17 m/s^2 peaks at 14.28 Hz). */
+#define HM_ESTIMATOR_WHEELSET_DISPLACEMENT_M 2.1e-3
 
 typedef enum {
   HM_POINT_WHEELSET = 0,    /* lateral acceleration of the wheelset (axle box): the model's y'' */

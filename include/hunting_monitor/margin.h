@@ -2,7 +2,10 @@
  * hunting_monitor - the distance to the linear critical (Hopf) speed, two ways, from identified hunting modes
  * (issue #9; docs/MODEL.md sections 2 and 5).
  *
- * Input: windows of data at a steady speed, each with its identified hunting mode (modal.h). A window is used when
+ * Input: windows of data at a steady or gradually changing speed (acceleration or braking up to about 0.5 km/h/s:
+ * monitor.h), each with its identified hunting mode (modal.h) and the speed's mean and range over it. The fit
+ * averages the decay rates along the range: the model's change of the decay rate over half the range, at the
+ * window's conicity, is a systematic error of its decay rate. A window is used when
  * its mode is valid, its speed varied by at most max_speed_spread_kmh, it is at min_speed_kmh or more, it does not
  * overlap the previous window used (so that the windows' errors are independent), and the model explains its decay
  * rate and frequency together (the inversion's misfit chi2, one degree of freedom, at most max_misfit_chi2: else the
@@ -17,7 +20,8 @@
  * (a) Model-based. Each window's (decay rate, frequency, speed) is inverted jointly for the equivalent conicity
  *     (inversion.h). The errors passed to the inversion are the fit's statistical ones and a systematic part:
  *     frequency_model_error (relative: how far the model's hunting frequency may be from the vehicle's) and
- *     decay_rate_model_error (relative: the identification's bias, up to 5-10% on the two simulators, README) with,
+ *     decay_rate_model_error (relative: the identification's bias, 2% or less on the independent simulator and
+ *     about 5% on ours, README) with,
  *     added to it, 1 / T for a window of T seconds (the rectangular window's leakage widens the peak by about that:
  *     near the Hopf speed, where |sigma| is small, it is the larger part). The
  *     windows' conicities are averaged with inverse-variance weights; the statistical part of the error shrinks
@@ -66,7 +70,7 @@ typedef struct {
   double change_z;               /* a window this many combined standard errors from the mean is a change */
 } hm_margin_config;
 
-/* Defaults: 1%, 10%, 10 km/h, 200 km/h, 900 s, 20 km/h, 150 km/h, z = 2 (about 95%), misfit chi2 9 (3 standard
+/* Defaults: 1%, 5%, 12 km/h, 200 km/h, 900 s, 20 km/h, 150 km/h, z = 2 (about 95%), misfit chi2 9 (3 standard
  * errors), change at 4 standard errors. */
 void hm_margin_config_default(hm_margin_config *cfg);
 hm_status hm_margin_config_validate(const hm_margin_config *cfg, char *why, size_t why_len);

@@ -14,7 +14,10 @@
  *  - the identification follows the estimator: restarted after a gap, redesigned for a measured sample rate, fed
  *    the same interpolated samples where the estimator bridged lost ones.
  * At a steady speed the identification's windows go to the margin with the speed's mean and range: the current
- * stretch provisionally (from min_window_s), committed in full windows (window_s) and when the stretch ends. A window
+ * stretch provisionally (from min_window_s), committed in full windows (window_s) and when the stretch ends. While
+ * the speed changes gradually (acceleration or braking up to about 0.5 km/h/s: the margin's max_speed_spread_kmh,
+ * 12 km/h, in at least min_window_s) the stretch that reached that spread is committed whole, windows back to back;
+ * the margin counts the model's change of the decay rate over the window's speed range as a systematic error. A window
  * during which an update saw a criterion met (hunting or its onset: sliding r.m.s., peaks, displacement) is not given
  * to the margin (HM_WINDOW_NONLINEAR): a hunting limit cycle is not the linear mode, and its "decay rate" of about
  * zero would read as a Hopf speed at the current speed (on the independent simulator it once read 168 km/h).
@@ -63,8 +66,10 @@ typedef struct {
   double mode_speed_kmh;       /* mean speed over its window */
   double mode_speed_spread_kmh;/* and its range */
   hm_window_verdict mode_verdict; /* whether the margin used that window */
-  int mode_steady;             /* mode.valid and its window was at a steady speed, without a criterion met: the
-                                  decay rate means what it says (a fit over a changing speed is shown as not valid) */
+  int mode_steady;             /* mode.valid and its window was one the margin can use (a steady speed, or one
+                                  changing gradually, its range within max_speed_spread_kmh), without a criterion
+                                  met: the decay rate means what it says at mode_speed_kmh (a fit over a speed
+                                  changing faster is shown as not valid) */
   double line_wavelength_m;    /* a periodic excitation in that window (mode.lines_found): V / f1 [m]; 0 if none */
   hm_margin_estimate margin;   /* conicity, Hopf speed model-based and model-free, mismatch */
   hm_assessment assessment;    /* level, reason, boundaries and margins */

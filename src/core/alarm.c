@@ -23,6 +23,7 @@ struct hm_alarm_s {
   int calm;               /* the release conditions hold since calm_since */
   double calm_since;
   double displacement_limit_m; /* the displacement criterion's limit (0: off) */
+  double hunted_at_kmh;   /* the lowest speed at which a criterion was met during the latch (INFINITY: none) */
   /* the last table lookups (at the conicity in use and at the interval's optimistic end), reused while their
    * conicity and the speed are unchanged */
   struct {
@@ -145,17 +146,15 @@ static hm_status resolve(const hm_alarm_config *cfg, const hm_vehicle *veh, hm_a
 hm_status hm_alarm_create(const hm_alarm_config *cfg, const hm_vehicle *veh, const hm_table table, hm_alarm *out,
                           char *why, size_t why_len) {
   if (!cfg || !veh || !table || !out) return HM_EINVAL;
-  hm_alarm_config c;
-  double lo, hi;
-  hm_status st = resolve(cfg, veh, &c, &lo, &hi, why, why_len);
-  if (st != HM_OK) return st;
   hm_alarm a = calloc(1, sizeof *a);
   if (!a) return HM_ENOMEM;
-  a->cfg = c;
-  a->veh = *veh;
-  a->prior_hopf_low_kmh = lo;
-  a->prior_hopf_high_kmh = hi;
+  const hm_status st = hm_alarm_set_config(a, cfg, veh, why, why_len);
+  if (st != HM_OK) {
+    free(a);
+    return st;
+  }
   a->table = table;
+  a->hunted_at_kmh = INFINITY;
   a->level = HM_LEVEL_NO_DATA;
   a->reason = HM_REASON_STARTUP;
   *out = a;
@@ -171,6 +170,7 @@ void hm_alarm_reset(hm_alarm a) {
   a->since = 0.0;
   a->lower_pending = 0;
   a->latched = a->calm = 0;
+  a->hunted_at_kmh = INFINITY;
   a->cache[0].valid = a->cache[1].valid = 0;
 }
 
@@ -189,7 +189,7 @@ static int oscillation_reason(hm_reason r) {
 static int calm_now(const hm_alarm a, const hm_estimate *e, const hm_assessment *s) {
   const double f = a->cfg.release_amplitude_fraction;
   const double limit = a->displacement_limit_m > 0.0 ? a->displacement_limit_m : s->edge_used_m;
-  const int small = limit > 0.0 ? s->amplitude_m < f * limit : s->amplitude_m < f * 2.1e-3;
+  const int small = s->amplitude_m < f * (limit > 0.0 ? limit : HM_ESTIMATOR_WHEELSET_DISPLACEMENT_M);
   return !e->rms_exceeded && !e->peaks_exceeded && !e->displacement_exceeded && small &&
          e->speed_kmh < s->hopf_low_kmh - a->cfg.hysteresis_kmh;
 }
@@ -232,8 +232,8 @@ static hm_level raw_level(const hm_alarm a, const hm_estimate *e, const hm_margi
   if (edge > 0.0 && amp >= edge * (1.0 - ha_alarm)) return *reason = HM_REASON_AMPLITUDE_BEYOND_EDGE, HM_LEVEL_ALARM;
   if (edge > 0.0 && amp >= edge * (c->warn_amplitude_fraction - ha_warn))
     return *reason = HM_REASON_AMPLITUDE_NEAR_EDGE, HM_LEVEL_WARN;
-  if (v >= s->hopf_low_kmh - c->warn_speed_margin_kmh - hv_warn) return *reason = HM_REASON_NEAR_HOPF, HM_LEVEL_WARN;
-  if (v >= s->hopf_low_kmh - c->watch_speed_margin_kmh - hv_watch)
+  if (v >= s->warn_from_kmh - hv_warn) return *reason = HM_REASON_NEAR_HOPF, HM_LEVEL_WARN;
+  if (v >= s->watch_from_kmh - hv_watch)
     return *reason = HM_REASON_APPROACHING_HOPF, HM_LEVEL_WATCH;
   if (g && g->model_mismatch) return *reason = HM_REASON_MODEL_MISMATCH, HM_LEVEL_WATCH;
   if (e->sample_rate_mismatch) return *reason = HM_REASON_RATE_MISMATCH, HM_LEVEL_WATCH;
@@ -284,9 +284,11 @@ static hm_status assess(hm_alarm a, const hm_estimate *e, const hm_margin_estima
     lo = fmin(lo, g->hopf_model_low_kmh);
     if (g->hopf_model_high_kmh < hi) hi = g->hopf_model_high_kmh, lambda_opt = g->conicity_low;
   }
-  if (g && g->model_mismatch && g->hopf_free_valid) { /* then the model-free interval bounds the level too */
+  /* the model-free interval's lower end counts when the vehicle does not behave like its model, and whenever its
+   * regression has residuals to check it (three windows or more); with a mismatch its upper end bounds too */
+  if (g && g->hopf_free_valid && (g->model_mismatch || g->n_windows >= HM_ALARM_FREE_MIN_WINDOWS)) {
     lo = fmin(lo, g->hopf_free_low_kmh);
-    if (g->hopf_free_high_kmh < hi) hi = g->hopf_free_high_kmh;
+    if (g->model_mismatch && g->hopf_free_high_kmh < hi) hi = g->hopf_free_high_kmh;
   }
   s->conicity = lambda;
   hm_table_lookup_result b, bo;
@@ -299,6 +301,12 @@ static hm_status assess(hm_alarm a, const hm_estimate *e, const hm_margin_estima
   s->hopf_low_kmh = fmin(lo, b.hopf_speed_kmh);
   s->hopf_high_kmh = fmax(hi, b.hopf_speed_kmh);
   s->boundaries = b;
+  /* the speed margins (alarm.h): in quadrature with an identified interval's statistical half-width, added to a
+   * range's lower end */
+  const double h = precise ? b.hopf_speed_kmh - s->hopf_low_kmh : 0.0;
+  const double from = precise ? b.hopf_speed_kmh : s->hopf_low_kmh;
+  s->warn_from_kmh = from - hypot(h, c->warn_speed_margin_kmh);
+  s->watch_from_kmh = from - hypot(h, c->watch_speed_margin_kmh);
   /* the edge: at the conicity in use where the origin is stable there; inside the Hopf interval above the point
    * estimate, at the interval's optimistic end (found by the lookup at the conicity whose Hopf speed is hopf_high,
    * which the table's affine 1/V^2 makes exact) */
@@ -331,6 +339,17 @@ hm_status hm_alarm_update(hm_alarm a, const hm_estimate *e, const hm_margin_esti
     s.margin_lowest_cycle_kmh = s.boundaries.lowest_cycle_speed_kmh - e->speed_kmh;
     s.amplitude_m = e->oscillation_valid ? e->amplitude_displacement_m : 0.0;
     s.amplitude_margin_m = s.edge_used_m > 0.0 ? s.edge_used_m - s.amplitude_m : 0.0;
+    /* hunting met a criterion at a speed below the interval: the vehicle's Hopf speed may be no higher (or it runs in
+     * the bistable band after a large disturbance): while the ALARM is held the interval reaches down to the lowest
+     * such speed, and the latch is released only below it */
+    if (e->rms_exceeded || e->peaks_exceeded || e->displacement_exceeded)
+      a->hunted_at_kmh = fmin(a->latched ? a->hunted_at_kmh : INFINITY, e->speed_kmh);
+    else if (!a->latched)
+      a->hunted_at_kmh = INFINITY;
+    if (a->hunted_at_kmh < s.hopf_low_kmh) {
+      s.hopf_low_kmh = a->hunted_at_kmh;
+      s.hopf_low_from_hunting = 1;
+    }
     target = raw_level(a, e, g, &s, a->level, &reason);
     if (target == HM_LEVEL_ALARM && oscillation_reason(reason)) {
       a->latched = 1;
@@ -343,6 +362,7 @@ hm_status hm_alarm_update(hm_alarm a, const hm_estimate *e, const hm_margin_esti
       else if (!a->calm) a->calm = 1, a->calm_since = now;
       if (a->calm && now - a->calm_since >= c->release_s) {
         a->latched = 0;
+        a->hunted_at_kmh = INFINITY;
       } else {
         target = HM_LEVEL_ALARM;
         reason = a->latch_reason;

@@ -73,7 +73,7 @@ void hm_estimator_config_criteria(hm_estimator_config *c, hm_measurement_point p
     c->peaks_band_low_hz = 2.0;
     c->peaks_band_high_hz = 20.0;
     c->peaks_limit_mps2 = 17.0;
-    c->displacement_limit_m = 2.1e-3;
+    c->displacement_limit_m = HM_ESTIMATOR_WHEELSET_DISPLACEMENT_M;
   }
   c->peaks_count = 6;
 }

@@ -53,8 +53,8 @@ const char *hm_window_verdict_text(hm_window_verdict v) {
 
 void hm_margin_config_default(hm_margin_config *c) {
   c->frequency_model_error = 0.01;
-  c->decay_rate_model_error = 0.10;
-  c->max_speed_spread_kmh = 10.0;
+  c->decay_rate_model_error = 0.05;
+  c->max_speed_spread_kmh = 12.0;
   c->min_speed_kmh = 200.0;
   c->memory_s = 900.0;
   c->min_speed_span_kmh = 20.0;
@@ -129,13 +129,26 @@ static hm_window_verdict prepare(const hm_margin m, double t_end, double speed_k
   if (speed_kmh < c->min_speed_kmh) return HM_WINDOW_TOO_SLOW;
   if (t_end - mode->window_s < m->last_end_s - 1e-9) return HM_WINDOW_OVERLAPS;
   /* statistical and systematic errors of the measured mode (the leakage of a T s window: about 1 / T) */
-  const double sys_sigma = c->decay_rate_model_error * fabs(mode->decay_rate_1_s) + 1.0 / fmax(mode->window_s, 1.0);
+  double sys_sigma = c->decay_rate_model_error * fabs(mode->decay_rate_1_s) + 1.0 / fmax(mode->window_s, 1.0);
   const double sys_f = c->frequency_model_error * mode->frequency_hz;
-  const double e_sigma = hypot(mode->decay_rate_se_1_s, sys_sigma), e_f = hypot(mode->frequency_se_hz, sys_f);
+  double e_sigma = hypot(mode->decay_rate_se_1_s, sys_sigma);
+  const double e_f = hypot(mode->frequency_se_hz, sys_f);
   hm_conicity_inversion inv;
   if (hm_conicity_from_mode(&m->coef, speed_kmh, mode->decay_rate_1_s, e_sigma, mode->frequency_hz, e_f, 1e-9, 60,
                             &inv) != HM_OK)
     return HM_WINDOW_NO_INVERSION;
+  /* the speed's range over the window: the fit averages the decay rates along it; the model's change over half the
+   * range, at the conicity found, is a systematic error (on a ramp at 0.5 km/h/s, 12 km/h in 24 s, 0.4 1/s near the
+   * Hopf speed of conicity 0.16), and the inversion is repeated with it */
+  double s_lo, s_hi, w_unused;
+  if (spread_kmh > 0.0 && hm_hunting_root(&m->coef, speed_kmh - 0.5 * spread_kmh, inv.conicity, &s_lo, &w_unused) == HM_OK &&
+      hm_hunting_root(&m->coef, speed_kmh + 0.5 * spread_kmh, inv.conicity, &s_hi, &w_unused) == HM_OK) {
+    sys_sigma = hypot(sys_sigma, 0.5 * fabs(s_hi - s_lo));
+    e_sigma = hypot(mode->decay_rate_se_1_s, sys_sigma);
+    if (hm_conicity_from_mode(&m->coef, speed_kmh, mode->decay_rate_1_s, e_sigma, mode->frequency_hz, e_f, 1e-9, 60,
+                              &inv) != HM_OK)
+      return HM_WINDOW_NO_INVERSION;
+  }
   w->t_end_s = t_end;
   if (!(inv.chi2 <= c->max_misfit_chi2)) return HM_WINDOW_MISFIT;
   /* the systematic part of the conicity's error: the weighted sensitivities applied to the systematic errors */

@@ -174,8 +174,11 @@ void hm_monitor_reset(hm_monitor m) {
 /* A fit of the identification. At a steady speed (the newest stretch whose speed varied by at most the margin's
  * max_speed_spread_kmh) the part of the stretch not yet given to the margin is fitted, up to window_s: a full
  * window is committed to the margin, a shorter one (from min_window_s) is its provisional window, committed when the
- * stretch ends. So a stretch contributes while it lasts and once in long, non-overlapping windows. Otherwise the
- * whole window is fitted for display only. */
+ * stretch ends. So a stretch contributes while it lasts and once in long, non-overlapping windows. While the speed
+ * changes gradually (acceleration or braking: the stretch ends where its speed range reached the spread, at 0.5
+ * km/h/s after 24 s) the stretch is committed whole when it has nothing committed in it: ramp windows back to back,
+ * at their mean speed (the margin counts the change of the model's decay rate over the window's speed range as a
+ * systematic error, margin.h). Otherwise the whole window is fitted for display only. */
 static void fit(hm_monitor m, double t) {
   m->cur.duration_s = isfinite(m->t_chunk) ? t - m->t_chunk : 0.0;
   m->chunks[m->chunk_head] = m->cur;
@@ -186,10 +189,15 @@ static void fit(hm_monitor m, double t) {
   const hm_modal_config *mc = &m->cfg.modal;
   speed_chunk steady;
   chunk_clear(&steady);
+  const double max_spread = m->cfg.margin.max_speed_spread_kmh;
+  int ramp = 0; /* the stretch ends where a gradual change of speed took it beyond max_spread: a ramp */
   for (size_t k = 0; k < m->n_chunks && steady.duration_s < mc->window_s; ++k) {
     const speed_chunk *c = &m->chunks[(m->chunk_head + m->n_chunks_cap - 1 - k) % m->n_chunks_cap];
-    if (c->n == 0.0 || fmax(steady.max, c->max) - fmin(steady.min, c->min) > m->cfg.margin.max_speed_spread_kmh)
+    if (c->n == 0.0) break;
+    if (fmax(steady.max, c->max) - fmin(steady.min, c->min) > max_spread) {
+      ramp = c->max - c->min <= max_spread && steady.max - steady.min >= 0.5 * max_spread;
       break;
+    }
     steady.min = fmin(steady.min, c->min);
     steady.max = fmax(steady.max, c->max);
     steady.sum += c->sum;
@@ -217,7 +225,8 @@ static void fit(hm_monitor m, double t) {
     m->committed_until = t;
     return;
   }
-  if (e.window_s >= mc->window_s * (1.0 - 1e-9)) {
+  /* a full window, or on a ramp the whole stretch the spread allows (back to back, each once) */
+  if (e.window_s >= mc->window_s * (1.0 - 1e-9) || (ramp && fresh >= steady.duration_s - 1e-9)) {
     hm_margin_add_window(m->margin, t, m->mode_speed, m->mode_spread, &e, &m->verdict);
     if (m->verdict == HM_WINDOW_USED) m->committed_until = t;
   } else {

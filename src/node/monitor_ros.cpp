@@ -343,6 +343,8 @@ void MonitorRos::onTimer(const ros::TimerEvent&) {
   m.hopf_speed_kmh = s.boundaries_valid ? finite(b.hopf_speed_kmh) : 0.0;
   m.hopf_speed_kmh_low = s.boundaries_valid ? finite(s.hopf_low_kmh) : 0.0;
   m.hopf_speed_kmh_high = s.boundaries_valid ? finite(s.hopf_high_kmh) : 0.0;
+  m.warn_from_kmh = s.boundaries_valid ? finite(s.warn_from_kmh) : 0.0;
+  m.watch_from_kmh = s.boundaries_valid ? finite(s.watch_from_kmh) : 0.0;
   m.lowest_cycle_speed_kmh = s.boundaries_valid ? finite(b.lowest_cycle_speed_kmh) : 0.0;
   m.margin_to_hopf_kmh = s.boundaries_valid ? finite(s.margin_hopf_kmh) : 0.0;
   m.margin_to_lowest_cycle_kmh = s.boundaries_valid ? finite(s.margin_lowest_cycle_kmh) : 0.0;

@@ -59,4 +59,10 @@ static inline double hm_test_uniform(double lo, double hi) {
   return lo + (hi - lo) * ((double)(r >> 11) / 9007199254740992.0);
 }
 
+/* Standard normal numbers (Box-Muller on the generator above). */
+static inline double hm_test_gauss(void) {
+  const double u1 = hm_test_uniform(1e-12, 1.0), u2 = hm_test_uniform(0.0, 1.0);
+  return sqrt(-2.0 * log(u1)) * cos(6.283185307179586 * u2);
+}
+
 #endif

@@ -143,7 +143,8 @@ static void hysteresis_and_hold_prevent_chatter(void) {
 
 /* Latching by cause (issue #21): an ALARM from the oscillation holds while the oscillation comes and goes, and is
  * released only after release_s (10 s) of calm (no criterion, displacement below half the 2.1 mm limit) with the
- * speed below the Hopf interval, then falls after the 3 s hold: 13 s after the calm began. A criterion met for 1 s
+ * speed below the Hopf interval, which reaches down to the speed it hunted at (470 km/h, far below the model's), then
+ * falls after the 3 s hold: 13 s after the calm began. A criterion met for 1 s
  * in every 5 s (a hunting wheelset on a varying track: the gaps outlast the 3 s hold) never lets the level below
  * ALARM; a calm oscillation
  * above the interval's lower end keeps it; a speed-only ALARM is not latched. */
@@ -165,19 +166,31 @@ static void oscillation_alarm_latches(void) {
     below += s.level != HM_LEVEL_ALARM;
   }
   HM_CHECK(below == 0 && s.latched, "%d statuses below ALARM while the oscillation came and went", below);
-  /* calm: 0.5 mm, no criterion */
+  /* calm (0.5 mm, no criterion) at the speed it hunted at, 470 km/h, 47.6 km/h below the model's interval: held,
+   * the interval's lower end at 470 km/h (the vehicle hunted there), the calm not counted (the speed is not below it) */
+  for (int k = 1; k <= 200; ++k) {
+    e = estimate(470.0, 0.5e-3);
+    hm_alarm_update(a, &e, NULL, 40.0 + 0.1 * k, &s);
+  }
+  HM_CHECK(s.level == HM_LEVEL_ALARM && s.latched && s.hopf_low_from_hunting && s.hopf_low_kmh == 470.0 &&
+               s.release_in_s == 10.0,
+           "calm at the hunting speed: %s, latched %d, low end %.1f (from hunting %d), release in %g s",
+           hm_level_name(s.level), s.latched, s.hopf_low_kmh, s.hopf_low_from_hunting, s.release_in_s);
+  /* calm at 466 km/h (below 470 by more than the 3 km/h hysteresis): released after 10 s, lowered 3 s later, the
+   * interval the model's again */
   double released = -1.0, lowered = -1.0;
   for (int k = 1; k <= 200; ++k) {
-    const double t = 40.0 + 0.1 * k;
-    e = estimate(470.0, 0.5e-3);
+    const double t = 60.0 + 0.1 * k;
+    e = estimate(466.0, 0.5e-3);
     hm_alarm_update(a, &e, NULL, t, &s);
     if (k == 50) HM_CHECK(s.latched && fabs(s.release_in_s - 5.1) < 0.11, "release in %g s after 4.9 s", s.release_in_s);
     if (!s.latched && released < 0.0) released = t;
     if (s.level != HM_LEVEL_ALARM && lowered < 0.0) lowered = t;
   }
-  HM_CHECK_DELTA(released, 40.1 + 10.0, 0.11, "released after 10 s of calm");
-  HM_CHECK_DELTA(lowered, 40.1 + 13.0, 0.11, "lowered after the 3 s hold");
-  HM_CHECK(s.level == HM_LEVEL_OK, "level after release: %s", hm_level_name(s.level));
+  HM_CHECK_DELTA(released, 60.1 + 10.0, 0.11, "released after 10 s of calm");
+  HM_CHECK_DELTA(lowered, 60.1 + 13.0, 0.11, "lowered after the 3 s hold");
+  HM_CHECK(s.level == HM_LEVEL_OK && !s.hopf_low_from_hunting && s.hopf_low_kmh > 500.0,
+           "level after release: %s, low end %.1f", hm_level_name(s.level), s.hopf_low_kmh);
   hm_alarm_destroy(a);
   /* calm oscillation but the speed inside the Hopf interval: held */
   a = make();
@@ -230,7 +243,8 @@ static void bad_configuration_and_input(void) {
 }
 
 /* With a conicity estimate (0.16 +- 0.003, as margin.h makes them): the Hopf interval is the closed form's at the
- * interval's conicities; inside it above the point estimate a small oscillation is WARN, not ALARM; above it ALARM;
+ * interval's conicities; the margins (10 and 30 km/h) combine with its lower half-width h in quadrature: WARN from
+ * point - sqrt(h^2 + 10^2), WATCH from point - sqrt(h^2 + 30^2), 0.5 km/h either side; inside it above the point estimate a small oscillation is WARN, not ALARM; above it ALARM;
  * a large standard error falls back to the vehicle's conicity; a mismatch or a sensor at another rate is WATCH; a
  * rate the filters cannot use is NO_DATA. */
 static void levels_with_a_conicity_estimate(void) {
@@ -244,14 +258,17 @@ static void levels_with_a_conicity_estimate(void) {
   g.hopf_model_kmh = hopf_closed_form(0.16);
   g.hopf_model_low_kmh = hopf_closed_form(0.166);
   g.hopf_model_high_kmh = hopf_closed_form(0.154);
+  const double h = g.hopf_model_kmh - g.hopf_model_low_kmh;
+  const double warn_from = g.hopf_model_kmh - sqrt(h * h + 100.0), watch_from = g.hopf_model_kmh - sqrt(h * h + 900.0);
   const struct {
     double v, amp;
     hm_level level;
     hm_reason reason;
   } cases[] = {
       {400.0, 0.0, HM_LEVEL_OK, HM_REASON_NORMAL},
-      {g.hopf_model_low_kmh - 20.0, 0.0, HM_LEVEL_WATCH, HM_REASON_APPROACHING_HOPF},
-      {g.hopf_model_low_kmh - 5.0, 0.0, HM_LEVEL_WARN, HM_REASON_NEAR_HOPF},
+      {watch_from + 0.5, 0.0, HM_LEVEL_WATCH, HM_REASON_APPROACHING_HOPF},
+      {warn_from - 0.5, 0.0, HM_LEVEL_WATCH, HM_REASON_APPROACHING_HOPF},
+      {warn_from + 0.5, 0.0, HM_LEVEL_WARN, HM_REASON_NEAR_HOPF},
       {g.hopf_model_kmh + 2.0, 0.0002, HM_LEVEL_WARN, HM_REASON_NEAR_HOPF},
       {g.hopf_model_kmh + 2.0, 0.009, HM_LEVEL_ALARM, HM_REASON_AMPLITUDE_BEYOND_EDGE},
       {g.hopf_model_high_kmh + 0.5, 0.0, HM_LEVEL_ALARM, HM_REASON_ABOVE_HOPF},
@@ -265,6 +282,8 @@ static void levels_with_a_conicity_estimate(void) {
              cases[i].v, cases[i].amp, hm_level_name(s.level), hm_reason_text(s.reason));
     HM_CHECK(s.conicity_from_estimate && s.conicity == 0.16, "estimate in use");
     HM_CHECK(s.hopf_low_kmh == g.hopf_model_low_kmh && s.hopf_high_kmh == g.hopf_model_high_kmh, "interval");
+    HM_CHECK_DELTA(s.warn_from_kmh, warn_from, 1e-6, "WARN from");
+    HM_CHECK_DELTA(s.watch_from_kmh, watch_from, 1e-6, "WATCH from");
     HM_CHECK_DELTA(s.boundaries.hopf_speed_kmh, g.hopf_model_kmh, 1e-6, "table Hopf vs closed form");
     hm_alarm_destroy(a);
   }
@@ -288,6 +307,27 @@ static void levels_with_a_conicity_estimate(void) {
   HM_CHECK(s.level == HM_LEVEL_WARN && s.reason == HM_REASON_NEAR_HOPF, "uncertain estimate at 400 km/h: %s",
            hm_level_name(s.level));
   hm_alarm_destroy(a);
+  /* the model-free interval 30 km/h lower (and valid): its lower end does not count from two windows, does from
+   * three (WARN from the point less sqrt(h^2 + 10^2), h now down to the model-free end) */
+  hm_margin_estimate lower = g;
+  lower.hopf_free_valid = 1;
+  lower.hopf_free_kmh = g.hopf_model_kmh - 30.0;
+  lower.hopf_free_low_kmh = g.hopf_model_low_kmh - 30.0;
+  lower.hopf_free_high_kmh = g.hopf_model_high_kmh - 30.0;
+  const double h_free = g.hopf_model_kmh - lower.hopf_free_low_kmh;
+  const double v_free = g.hopf_model_kmh - sqrt(h_free * h_free + 100.0) + 0.5;
+  e = estimate(v_free, 0.0);
+  for (unsigned n = 2; n <= 3; ++n) {
+    lower.n_windows = n;
+    a = make();
+    HM_CHECK(hm_alarm_update(a, &e, &lower, 0.0, &s) == HM_OK, "update");
+    HM_CHECK_DELTA(s.hopf_low_kmh, n == 3 ? lower.hopf_free_low_kmh : g.hopf_model_low_kmh, 1e-9, "low end");
+    HM_CHECK_DELTA(s.hopf_high_kmh, g.hopf_model_high_kmh, 1e-9, "high end (no mismatch: the model's)");
+    HM_CHECK(s.level == (n == 3 ? HM_LEVEL_WARN : HM_LEVEL_OK), "model-free lower, %u windows: %s", n,
+             hm_level_name(s.level));
+    hm_alarm_destroy(a);
+  }
+  e = estimate(400.0, 0.0);
   hm_margin_estimate mismatch = g;
   mismatch.model_mismatch = 1;
   a = make();

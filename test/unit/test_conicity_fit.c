@@ -6,16 +6,11 @@
 #include "hunting_monitor/conicity_fit.h"
 #include "hunting_monitor/linear.h"
 
-static double gauss_noise(void) { /* Box-Muller on the harness's deterministic generator */
-  const double u1 = hm_test_uniform(1e-12, 1.0), u2 = hm_test_uniform(0.0, 1.0);
-  return sqrt(-2.0 * log(u1)) * cos(2.0 * HM_PI * u2);
-}
-
 static void sample(const hm_conicity *truth, double *y, double *l, size_t n, double sigma) {
   for (size_t i = 0; i < n; ++i) {
     y[i] = (-12.0 + 24.0 * (double)i / (double)(n - 1)) * 1e-3;
     hm_conicity_eval(truth, y[i], &l[i], NULL);
-    if (sigma > 0.0) l[i] += sigma * gauss_noise();
+    if (sigma > 0.0) l[i] += sigma * hm_test_gauss();
   }
 }
 

@@ -25,11 +25,6 @@ void *__wrap_realloc(void *p, size_t n) {
   return __real_realloc(p, n);
 }
 
-static double noise(void) {
-  const double u1 = hm_test_uniform(1e-12, 1.0), u2 = hm_test_uniform(0.0, 1.0);
-  return sqrt(-2.0 * log(u1)) * cos(2.0 * HM_PI * u2);
-}
-
 static int all_finite(const hm_estimate *r) {
   return isfinite(r->time_s) && isfinite(r->speed_kmh) && isfinite(r->amplitude_accel_mps2) &&
          isfinite(r->frequency_hz) && isfinite(r->amplitude_displacement_m) && isfinite(r->period_spread) &&
@@ -66,7 +61,7 @@ static void sinusoids_with_noise_and_drift(void) {
           if (i % (long)(fs / 50) == 0) hm_estimator_push_speed(e, t, 400.0);
           const double drift = 0.1 * t + 0.5 * sin(2.0 * HM_PI * 0.3 * t);
           const double sigma = 0.1 * A * sqrt(fs / 2000.0);
-          hm_estimator_push_accel(e, t, A * sin(2.0 * HM_PI * f * t + 0.3) + sigma * noise() + drift);
+          hm_estimator_push_accel(e, t, A * sin(2.0 * HM_PI * f * t + 0.3) + sigma * hm_test_gauss() + drift);
           if (t >= 2.0 * tracking && i % (long)(fs / 2) == 0) {
             hm_estimate est;
             hm_estimator_read(e, t, &est);
@@ -412,7 +407,7 @@ static void long_stream_no_allocation(void) {
   for (long i = 0; i < n; ++i) {
     t += (i % 500000 == 499999) ? 0.2 : 0.0005; /* a gap every 250 s */
     if (i % 40 == 0) hm_estimator_push_speed(e, t, 300.0 + 200.0 * fabs(sin(t / 600.0)));
-    const double a = (i % 100003 == 0) ? NAN : 3.0 * sin(2.0 * HM_PI * 13.0 * t) + 0.5 * noise();
+    const double a = (i % 100003 == 0) ? NAN : 3.0 * sin(2.0 * HM_PI * 13.0 * t) + 0.5 * hm_test_gauss();
     hm_estimator_push_accel(e, t, a);
     if (i % 2000 == 0) {
       hm_estimator_read(e, t, &est);

@@ -12,14 +12,9 @@ static const double FS = 100.0, T = 40.0;
 static double x[N], power[N / 2 + 1], cos_t[N], sin_t[N];
 static unsigned char excl[N / 2 + 1];
 
-static double noise(void) {
-  const double u1 = hm_test_uniform(1e-12, 1.0), u2 = hm_test_uniform(0.0, 1.0);
-  return sqrt(-2.0 * log(u1)) * cos(2.0 * HM_PI * u2);
-}
-
 /* White noise of unit variance plus sinusoids (frequency, amplitude, random phase); its periodogram |X_k|^2. */
 static void spectrum_of(const double *f, const double *amp, int n_lines) {
-  for (int i = 0; i < N; ++i) x[i] = noise();
+  for (int i = 0; i < N; ++i) x[i] = hm_test_gauss();
   for (int l = 0; l < n_lines; ++l) {
     const double ph = hm_test_uniform(0.0, 2.0 * HM_PI);
     for (int i = 0; i < N; ++i) x[i] += amp[l] * sin(2.0 * HM_PI * f[l] * i / FS + ph);

@@ -6,11 +6,6 @@
 #include "hunting_monitor/modal.h"
 #include "hunting_monitor/model.h"
 
-static double noise(void) {
-  const double u1 = hm_test_uniform(1e-12, 1.0), u2 = hm_test_uniform(0.0, 1.0);
-  return sqrt(-2.0 * log(u1)) * cos(2.0 * HM_PI * u2);
-}
-
 /* A single-degree-of-freedom oscillator y'' + 2 zeta w y' + w^2 y = white noise, integrated by RK4 at 10 substeps
  * per sample with the force held over the sample (white up to far above the band), its acceleration sampled at fs
  * with white sensor noise of sensor_rel times the signal's r.m.s. Its poles are sigma = -zeta w, w_d = w sqrt(1 -
@@ -53,15 +48,15 @@ static void decay_rate_of_a_known_oscillator(void) {
     int covered = 0, n = 0;
     double ms = 0.0; /* settle, and the signal's r.m.s. for the sensor noise */
     for (int k = 0; k < 20000; ++k) {
-      const double a = sdof_step(&s, 1000.0 * noise(), 1.0 / fs);
+      const double a = sdof_step(&s, 1000.0 * hm_test_gauss(), 1.0 / fs);
       if (k >= 10000) ms += a * a / 10000.0;
     }
     const double sensor = 0.1 * sqrt(ms);
     for (int win = 0; win < 12; ++win) {
       hm_modal_reset(m);
       for (long k = 0; k < (long)(40.0 * fs); ++k) {
-        const double a = sdof_step(&s, 1000.0 * noise(), 1.0 / fs);
-        hm_modal_push(m, a + sensor * noise());
+        const double a = sdof_step(&s, 1000.0 * hm_test_gauss(), 1.0 / fs);
+        hm_modal_push(m, a + sensor * hm_test_gauss());
       }
       hm_mode_estimate e;
       HM_CHECK(hm_modal_fit(m, 40.0, &e) == HM_OK && e.valid, "sigma %g window %d: fit (valid %d)", sigmas[i], win,
@@ -98,7 +93,7 @@ static void rates_and_no_mode(void) {
     hm_modal m = NULL;
     HM_CHECK(hm_modal_create(&c, fs, &m, NULL, 0) == HM_OK, "create at %g Hz", fs);
     if (!m) return;
-    for (long k = 0; k < (long)(40.0 * fs); ++k) hm_modal_push(m, sdof_step(&s, 1000.0 * noise(), 1.0 / fs));
+    for (long k = 0; k < (long)(40.0 * fs); ++k) hm_modal_push(m, sdof_step(&s, 1000.0 * hm_test_gauss(), 1.0 / fs));
     hm_mode_estimate e;
     HM_CHECK(hm_modal_fit(m, 40.0, &e) == HM_OK && e.valid, "fit at %g Hz", fs);
     HM_CHECK_DELTA(e.decay_rate_1_s, -1.0, 4.0 * e.decay_rate_se_1_s, "decay rate");
@@ -109,7 +104,7 @@ static void rates_and_no_mode(void) {
   }
   hm_modal m = NULL;
   hm_modal_create(&c, 1000.0, &m, NULL, 0);
-  for (long k = 0; k < 40000; ++k) hm_modal_push(m, noise());
+  for (long k = 0; k < 40000; ++k) hm_modal_push(m, hm_test_gauss());
   hm_mode_estimate e;
   const hm_status st = hm_modal_fit(m, 40.0, &e);
   HM_CHECK(st == HM_ENOCONV || (st == HM_OK && !e.valid), "white noise taken for a mode: %g Hz, %g 1/s",
@@ -135,7 +130,7 @@ static void joints_are_not_the_mode(void) {
     if (!m) return;
     double ms = 0.0;
     for (int k = 0; k < 20000; ++k) {
-      const double a = sdof_step(&s, 1000.0 * noise(), 1.0 / fs);
+      const double a = sdof_step(&s, 1000.0 * hm_test_gauss(), 1.0 / fs);
       if (k >= 10000) ms += a * a / 10000.0;
     }
     /* each harmonic's amplitude: a third of the response's r.m.s. (the one on the peak stands about 40x above the
@@ -148,7 +143,7 @@ static void joints_are_not_the_mode(void) {
       for (long k = 0; k < (long)(40.0 * fs); ++k, t += 1.0 / fs) {
         double lines = 0.0;
         for (int h = 1; h <= 5; ++h) lines += amp * sin(2.0 * HM_PI * h * f1 * t + h);
-        hm_modal_push(m, sdof_step(&s, 1000.0 * noise(), 1.0 / fs) + lines);
+        hm_modal_push(m, sdof_step(&s, 1000.0 * hm_test_gauss(), 1.0 / fs) + lines);
       }
       hm_mode_estimate e;
       if (hm_modal_fit(m, 40.0, &e) != HM_OK || !e.valid) continue;
@@ -207,7 +202,7 @@ static void coverage_of_the_intervals(void) {
         if (!m) return;
         double x1 = 0.0, x2 = 0.0;
         for (long k = 0; k < (long)(200.0 * fs); ++k) { /* settle: 10 decay times of the slowest */
-          const double x = a1 * x1 + a2 * x2 + noise();
+          const double x = a1 * x1 + a2 * x2 + hm_test_gauss();
           x2 = x1, x1 = x;
         }
         int n = 0, in_stat = 0, in_leak = 0;
@@ -217,13 +212,13 @@ static void coverage_of_the_intervals(void) {
           const long ns = (long)(T * fs);
           static double buf[40 * 2000];
           for (long k = 0; k < ns; ++k) {
-            const double x = a1 * x1 + a2 * x2 + noise();
+            const double x = a1 * x1 + a2 * x2 + hm_test_gauss();
             x2 = x1, x1 = x;
             buf[k] = x;
             ms += x * x / (double)ns;
           }
           const double sensor = 0.1 * sqrt(ms);
-          for (long k = 0; k < ns; ++k) hm_modal_push(m, buf[k] + sensor * noise());
+          for (long k = 0; k < ns; ++k) hm_modal_push(m, buf[k] + sensor * hm_test_gauss());
           hm_mode_estimate e;
           if (hm_modal_fit(m, T, &e) != HM_OK || !e.valid) continue;
           ++n;
