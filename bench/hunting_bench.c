@@ -7,6 +7,7 @@
 
 #include "hunting_monitor/monitor.h"
 #include "hunting_monitor/conicity_fit.h"
+#include "hunting_monitor/eqcon.h"
 #include "hunting_monitor/estimator.h"
 #include "hunting_monitor/cycles.h"
 #include "hunting_monitor/hopf.h"
@@ -255,6 +256,31 @@ static void bench_monitor(double *ns_push, double *ns_monitor, double *ns_update
   free(x);
 }
 
+/* EN 15302 from a delta-r of 201 points (-10..10 mm every 0.1 mm, a worn profile's cubic rise): the 66 amplitudes
+ * 1..7.5 mm by each method, the table's set-up included [ms], best of 5. */
+static void bench_eqcon(double *int_ms, double *reg_ms) {
+  static double y[201], dr[201];
+  for (int k = 0; k < 201; ++k) {
+    y[k] = 1e-3 * (-10.0 + 0.1 * k);
+    dr[k] = 2.0 * (0.05 * y[k] + 800.0 * y[k] * y[k] * y[k]);
+  }
+  hm_eqcon_config c;
+  hm_eqcon_config_default(&c);
+  for (int m = 0; m < 2; ++m) {
+    double best = INFINITY;
+    for (int rep = 0; rep < 5; ++rep) {
+      const double t0 = now_s();
+      hm_eqcon e = NULL;
+      if (hm_eqcon_create(&c, y, dr, 201, &e, NULL, 0) != HM_OK) break;
+      hm_eqcon_result r;
+      for (int a = 0; a < 66; ++a) hm_eqcon_at(e, (hm_eqcon_method)m, 1e-3 * (1.0 + 0.1 * a), &r);
+      hm_eqcon_destroy(e);
+      best = fmin(best, now_s() - t0);
+    }
+    *(m == 0 ? int_ms : reg_ms) = best * 1e3;
+  }
+}
+
 int main(void) {
   hm_vehicle veh;
   hm_vehicle_default(&veh);
@@ -312,6 +338,8 @@ int main(void) {
   const double fit_s = bench_fit(20, &fit_rmse);
   double ns_push, ns_monitor, ns_update, us_fit;
   bench_monitor(&ns_push, &ns_monitor, &ns_update, &us_fit);
+  double eq_int_ms = NAN, eq_reg_ms = NAN;
+  bench_eqcon(&eq_int_ms, &eq_reg_ms);
 
   printf("{\n");
   printf("  \"closed_form_critical_speeds_per_s\": %.4g,\n", closed_per_s);
@@ -334,6 +362,8 @@ int main(void) {
   printf("  \"table_lookup_ns\": %.4g,\n", lookup_ns);
   printf("  \"conicity_fit_500_points_3_terms_ms\": %.4g,\n", fit_s * 1e3);
   printf("  \"conicity_fit_rmse\": %.5f,\n", fit_rmse);
+  printf("  \"equivalent_conicity_66_amplitudes_integration_ms\": %.4g,\n", eq_int_ms);
+  printf("  \"equivalent_conicity_66_amplitudes_regression_ms\": %.4g,\n", eq_reg_ms);
   printf("  \"estimator_ns_per_sample\": %.4g,\n", ns_push);
   printf("  \"monitor_with_identification_ns_per_sample\": %.4g,\n", ns_monitor);
   printf("  \"identification_fit_40s_window_us\": %.4g,\n", us_fit);

@@ -106,6 +106,8 @@ int cmd_table_lookup(const cli_args *a);
 extern const cli_option fit_conicity_opts[], estimate_opts[];
 int cmd_estimate(const cli_args *a);
 int cmd_fit_conicity(const cli_args *a);
+extern const cli_option equivalent_conicity_opts[];
+int cmd_equivalent_conicity(const cli_args *a);
 int cli_fail_status(const char *what, hm_status st);
 int cli_speed_option(const cli_args *a, double *v_kmh);
 

@@ -438,6 +438,13 @@ static const command commands[] = {
      "y_m,conicity (or y_mm,conicity with --y-unit mm): parameters with standard errors, SSE, R^2, adjusted\n"
      "R^2, RMSE, lambda(0) and the vehicle's Hopf speed with it; --write-config writes a vehicle config.",
      fit_conicity_opts, cmd_fit_conicity},
+    {"equivalent-conicity", "equivalent conicity per amplitude from delta-r (EN 15302)",
+     "--delta-r FILE.csv [--method integration|regression] [--amplitudes 1:7.5:0.1] [options]",
+     "Equivalent conicity tan gamma_e per amplitude from the rolling-radius difference (CSV y_mm,delta_r_mm:\n"
+     "r_left - r_right as the wheelset moves y to the left): EN 15302's integration method (the kinematic\n"
+     "oscillation's wavelength against Klingel's for a cone) or the regression weighted by a sinusoid's\n"
+     "distribution; null beyond the data. --csv-out writes y_mm,conicity for 'hunting fit-conicity --y-unit mm'.",
+     equivalent_conicity_opts, cmd_equivalent_conicity},
     {"estimate", "run the online monitor over recorded acceleration and speed",
      "--accel FILE.csv (--speed FILE.csv | --v KM/H) [--table FILE] [--monitor FILE] [--every S]",
      "Run exactly the online estimator and alarm code over recorded data (CSV t_s,accel_mps2 and t_s,speed_kmh)\n"

@@ -28,6 +28,14 @@ def run_json(*args):
     return json.loads(run(*args).stdout)
 
 
+def write_file(d, name, text):
+    """text into d/name; the path."""
+    path = os.path.join(d, name)
+    with open(path, "w") as f:
+        f.write(text)
+    return path
+
+
 def close(x, ref, tol, what):
     if not abs(x - ref) <= tol:
         raise AssertionError(f"{what} = {x!r}, expected {ref!r} +- {tol}")
@@ -302,10 +310,7 @@ def test_fit_conicity_sample_and_config():
 def test_fit_conicity_bad_input():
     with tempfile.TemporaryDirectory() as d:
         def write(name, text):
-            path = os.path.join(d, name)
-            with open(path, "w") as f:
-                f.write(text)
-            return path
+            return write_file(d, name, text)
         cases = [
             ([os.path.join(d, "missing.csv")], "cannot open"),
             ([write("hdr.csv", "y,lambda\n0,0.1\n")], "the header must be 'y_m,conicity'"),
@@ -428,10 +433,7 @@ def test_estimate_bad_and_stale_input():
         assert p.returncode == 1 and "tracking_time_s: must be at most 20" in p.stderr, p.stderr
         # inputs that used to run without a word
         def write(name, text):
-            path = os.path.join(d, name)
-            with open(path, "w") as f:
-                f.write(text)
-            return path
+            return write_file(d, name, text)
         slow = write("slow.csv", "t_s,accel_mps2\n" + "".join(f"{i / 50:.3f},0.1\n" for i in range(500)))
         corrupt = write("corrupt.tbl", open(tbl).read().replace("hopf_kmh ", "hopf_kmh 0 x", 1)
                         .replace(" x", " junk ", 1))
@@ -486,6 +488,56 @@ def test_estimate_streams_long_recordings():
         peak_kb = int(p.stderr.strip().splitlines()[-1])
         close(out[-1]["t_s"], (n - 1) / 2000, 1e-9, "last line at the last sample")
         assert peak_kb < 30_000, f"peak RSS {peak_kb} kB for a 51 MB recording"
+
+
+def test_equivalent_conicity_of_a_cone_with_unequal_radii():
+    # delta-r = 2 y tan(gamma) + 0.3 mm, tan(gamma) = 0.05, over -10..10 mm: tan gamma_e = 0.05 at every amplitude
+    # by both methods, the equilibrium at -0.3 / 0.1 = -3 mm, null where the oscillation leaves the data (beyond 7 mm
+    # about -3 mm), the wavelength Klingel's 2 pi sqrt(e0 r0 / tan gamma); --csv-out gives fit-conicity's input
+    with tempfile.TemporaryDirectory() as d:
+        path, out = os.path.join(d, "dr.csv"), os.path.join(d, "con.csv")
+        with open(path, "w") as f:
+            f.write("y_mm,delta_r_mm\n")
+            for k in range(-100, 101):
+                f.write(f"{0.1 * k:.1f},{2 * 0.1 * k * 0.05 + 0.3:.6f}\n")
+        klingel = 2 * math.pi * math.sqrt(0.75 * 0.46 / 0.05)
+        for method in ("integration", "regression"):
+            r = run_json("equivalent-conicity", "--delta-r", path, "--amplitudes", "1:8:0.5", "--method", method,
+                         "--csv-out", out)
+            assert r["method"] == method and r["points"] == 201, r
+            close(r["equilibrium_mm"], -3.0, 1e-9, "equilibrium")
+            close(r["conicity_3mm"], 0.05, 1e-8, f"{method}: tan gamma_e at 3 mm")
+            for a, c, w in zip(r["amplitude_mm"], r["conicity"], r["wavelength_m"]):
+                if a < 7.0:
+                    close(c, 0.05, 1e-8, f"{method}: tan gamma_e at {a} mm")
+                    close(w, klingel, 1e-6, f"{method}: wavelength at {a} mm")
+                elif a > 7.0:
+                    assert c is None and w is None, (method, a, c)
+            with open(out) as f:
+                rows = f.read().split()
+            assert rows[0] == "y_mm,conicity" and len(rows) in (1 + 2 * 12, 1 + 2 * 13), rows[:3]
+            assert float(rows[1].split(",")[0]) <= -6.5 and float(rows[-1].split(",")[0]) >= 6.5, rows[1]
+            assert all(abs(float(x.split(",")[1]) - 0.05) < 1e-8 for x in rows[1:]), rows[:3]
+    # bad files and options: one line on stderr, nothing on stdout
+    with tempfile.TemporaryDirectory() as d:
+        def write(name, text):
+            return write_file(d, name, text)
+        cases = [
+            ([], "give the delta-r file"),
+            (["--delta-r", write("h.csv", "y,dr\n0,0\n1,1\n2,2\n")], "the header must be 'y_mm,delta_r_mm'"),
+            (["--delta-r", write("b.csv", "y_mm,delta_r_mm\n-1,-0.1\n1,0.1\n0,0\n")], "y must increase strictly"),
+            (["--delta-r", write("f.csv", "y_mm,delta_r_mm\n-1,0.1\n0,0\n1,-0.1\n")], "no restoring equilibrium"),
+            (["--delta-r", write("t.csv", "y_mm,delta_r_mm\n-1,-0.1\n1,0.1\n")], "at least 3 are needed"),
+            (["--delta-r", write("n.csv", "y_mm,delta_r_mm\n-1,-0.1\n0,x\n1,0.1\n")], "n.csv:3"),
+            (["--delta-r", write("ok.csv", "y_mm,delta_r_mm\n-1,-0.1\n0,0\n1,0.1\n"),
+              "--amplitudes", "3:1:0.1"], "--amplitudes must be FROM:TO:STEP"),
+            (["--delta-r", os.path.join(d, "ok.csv"), "--method", "fourier"], "--method must be integration or regression"),
+            (["--delta-r", os.path.join(d, "ok.csv"), "--r0-mm", "-460"], "r0_m: must be in (0, 5]"),
+        ]
+        for args, message in cases:
+            p = run("equivalent-conicity", *args, ok=False)
+            assert p.returncode != 0 and message in p.stderr and p.stdout == "", (args, p.stderr, p.stdout)
+            assert p.stderr.count("\n") == 1, p.stderr
 
 
 def test_json_numbers_round_trip():
