@@ -23,9 +23,12 @@
  *    motion of amplitude a, i.e. with y = y_eq + a sin(phi), phi uniform; its slope is 2 tan gamma_e:
  *        tan gamma_e = (1 / (pi a)) int_{-pi/2}^{pi/2} delta-r(y_eq + a sin phi) sin phi dphi
  *    (the harmonic linearisation; the same quadrature).
+ * A dead zone (delta-r = 0 about the equilibrium, as worn profile pairs have: EN 15302's case E4) restores nothing:
+ * an amplitude within it has tan gamma_e = 0 and an infinite wavelength.
  * Both give tan gamma at every amplitude for a cone (delta-r = 2 y tan gamma) and for an offset one; for delta-r
  * = 2 (t y + k y^3) the integration gives Duffing's period (a complete elliptic integral) and the regression t + 3/4
- * k a^2 (test_eqcon).
+ * k a^2; a dead zone the closed form of arcs joined by a drift (test_eqcon). On EN 15302's nine reference delta-r
+ * functions (Annex E, test/cli/en15302) the integration lies within 0.01-0.12 of the allowed band at 1-5 mm.
  * An amplitude whose oscillation leaves the table (or, for the regression, y_eq -+ a) is undefined: HM_EDOMAIN.
  * Allocation only at create.
  */

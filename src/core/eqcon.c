@@ -258,6 +258,20 @@ hm_status hm_eqcon_at(const hm_eqcon t, hm_eqcon_method method, double amplitude
     *out = r;
     return HM_OK;
   }
+  /* a dead zone (delta-r = 0 about the equilibrium, as a worn profile pair can have): an oscillation within it has
+   * no restoring term, tan gamma_e = 0 (an infinite wavelength) */
+  size_t kl = segment(t, t->y_eq), kr = kl + 1;
+  while (kl > 0 && t->dr[kl] == 0.0 && t->dr[kl - 1] == 0.0) --kl;
+  while (kr + 1 < n && t->dr[kr] == 0.0 && t->dr[kr + 1] == 0.0) ++kr;
+  const double zl = t->dr[kl] == 0.0 ? y[kl] : t->y_eq, zr = t->dr[kr] == 0.0 ? y[kr] : t->y_eq;
+  if (amplitude_m <= 0.5 * (zr - zl) * (1.0 + 1e-6)) {
+    r.tan_gamma_e = 0.0;
+    r.wavelength_m = INFINITY;
+    r.y_low_m = zl;
+    r.y_high_m = zr;
+    *out = r;
+    return HM_OK;
+  }
   /* J for the amplitude: half the distance between the turning points rises with J; bisection on J between 0 and
    * the largest J the table holds on both sides */
   const double j_max = fmin(potential(t, y[n - 1]), potential(t, y[0]));

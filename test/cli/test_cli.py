@@ -540,6 +540,28 @@ def test_equivalent_conicity_of_a_cone_with_unequal_radii():
             assert p.stderr.count("\n") == 1, p.stderr
 
 
+def test_equivalent_conicity_en15302_reference_cases():
+    # EN 15302 Annex E/F (test/cli/en15302): the integration method within the reference band at every amplitude
+    # from 1 to 5 mm on all nine delta-r functions, symmetric, with unequal radii, with a dead zone (E4: tan gamma_e
+    # 0 within +-1.7 mm) and two different wheels (E9)
+    base = os.path.join(SRC, "test", "cli", "en15302")
+    report = []
+    for n in range(1, 10):
+        r = run_json("equivalent-conicity", "--delta-r", os.path.join(base, f"E{n}_delta_r.csv"), "--amplitudes",
+                     "1:5:0.1")
+        with open(os.path.join(base, f"E{n}_reference.csv")) as f:
+            ref = {round(float(a), 3): (float(t), float(hi), float(lo))
+                   for a, t, hi, lo in (line.strip().split(",") for line in list(f)[1:])}
+        worst = 0.0
+        for a, c in zip(r["amplitude_mm"], r["conicity"]):
+            t, hi, lo = ref[round(a, 3)]
+            assert c is not None and lo - 1e-9 <= c <= hi + 1e-9, (n, a, c, t, lo, hi)
+            worst = max(worst, abs(c - t) / max(hi - t, t - lo))
+        close(r["conicity_3mm"], ref[3.0][0], 0.005, f"E{n} at 3 mm")
+        report.append(f"E{n} {r['conicity_3mm']:.3f} ({worst:.2f} of the band)")
+    print("  EN 15302 at 3 mm: " + "; ".join(report))
+
+
 def test_json_numbers_round_trip():
     # numbers are written in their shortest form that reads back as the same double: a configured 8.96 MN/m comes
     # out as 8.96, a whole speed without an exponent, and a computed critical speed with every digit it needs (the

@@ -24,6 +24,7 @@ static size_t tabulate(double half_mm, double step_mm, double (*f)(double y, con
 static double cone(double y, const double *p) { return 2.0 * y * p[0] + p[1]; }
 static double cubic(double y, const double *p) { return 2.0 * (p[0] * y + p[1] * y * y * y); }
 static double quadratic(double y, const double *p) { return 2.0 * p[0] * y + p[1] * y * y; }
+static double dead_zone(double y, const double *p) { return fabs(y) <= p[1] ? 0.0 : 2.0 * p[0] * (y - copysign(p[1], y)); }
 
 static hm_eqcon make(size_t n) {
   hm_eqcon_config c;
@@ -164,6 +165,28 @@ static void asymmetric_function_against_rk4(void) {
   hm_eqcon_destroy(e);
 }
 
+/* A dead zone (worn profiles, EN 15302's case E4): delta-r = 0 for |y| <= d = 1 mm, a cone of 0.1 outside. Within
+ * the zone nothing restores: tan gamma_e = 0 up to a = d; beyond, the motion is the cone's harmonic arcs joined by a
+ * straight drift across 2 d at the slope w (a - d): L = (2 pi / w) (1 + 2 d / (pi (a - d))), so tan gamma_e =
+ * 0.1 / (1 + 2 d / (pi (a - d)))^2 (to 1e-6). */
+static void dead_zone_against_closed_form(void) {
+  const double t = 0.1, d = 1e-3, p[2] = {t, d};
+  hm_eqcon e = make(tabulate(10.0, 0.1, dead_zone, p));
+  double worst = 0.0;
+  for (double a_mm = 0.5; a_mm <= 7.5 + 1e-9; a_mm += 0.5) {
+    hm_eqcon_result r;
+    HM_CHECK(hm_eqcon_at(e, HM_EQCON_INTEGRATION, 1e-3 * a_mm, &r) == HM_OK, "amplitude %g mm", a_mm);
+    const double a = 1e-3 * a_mm, ref = a <= d ? 0.0 : t / pow(1.0 + 2.0 * d / (PI * (a - d)), 2.0);
+    if (a <= d)
+      HM_CHECK(r.tan_gamma_e == 0.0 && isinf(r.wavelength_m), "inside the zone: %g", r.tan_gamma_e);
+    else
+      worst = fmax(worst, fabs(r.tan_gamma_e / ref - 1.0));
+  }
+  HM_CHECK(worst < 1e-6, "off the closed form by %.2g", worst);
+  printf("  dead zone of +-1 mm on a 0.1 cone: 0 within it, the closed form to %.1e beyond\n", worst);
+  hm_eqcon_destroy(e);
+}
+
 /* Bad input: named errors, outputs untouched; amplitudes beyond the table undefined. */
 static void bad_input(void) {
   hm_eqcon_config c;
@@ -200,6 +223,7 @@ int main(void) {
   HM_RUN(unequal_radii_shift_the_equilibrium);
   HM_RUN(cubic_against_duffing_and_harmonic_balance);
   HM_RUN(asymmetric_function_against_rk4);
+  HM_RUN(dead_zone_against_closed_form);
   HM_RUN(bad_input);
   HM_TEST_EXIT();
 }
