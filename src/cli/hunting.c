@@ -438,6 +438,13 @@ static const command commands[] = {
      "y_m,conicity (or y_mm,conicity with --y-unit mm): parameters with standard errors, SSE, R^2, adjusted\n"
      "R^2, RMSE, lambda(0) and the vehicle's Hopf speed with it; --write-config writes a vehicle config.",
      fit_conicity_opts, cmd_fit_conicity},
+    {"delta-r", "rolling-radius difference from wheel and rail profiles",
+     "--wheel FILE.csv --rail FILE.csv [--out DR.csv] [options]",
+     "Rolling-radius difference delta-r = r_left - r_right over lateral shifts of the wheelset (rigid single-point\n"
+     "contact, roll neglected): wheel profile y_mm,z_mm (y from the flange back to the field side, z = radius - r0),\n"
+     "rail profile y_mm,z_mm in the rail's axes (y to the field side, z up), mirrored for the right side unless\n"
+     "given; rails inclined 1:40, gauge 1435 mm at 14 mm below the top, flange backs 1360 mm apart.",
+     delta_r_opts, cmd_delta_r},
     {"equivalent-conicity", "equivalent conicity per amplitude from delta-r (EN 15302)",
      "--delta-r FILE.csv [--method integration|regression] [--amplitudes 1:7.5:0.1] [options]",
      "Equivalent conicity tan gamma_e per amplitude from the rolling-radius difference (CSV y_mm,delta_r_mm:\n"

@@ -562,6 +562,50 @@ def test_equivalent_conicity_en15302_reference_cases():
     print("  EN 15302 at 3 mm: " + "; ".join(report))
 
 
+def test_delta_r_from_profiles_and_the_chain():
+    # a cone of 0.05 on knife-edge rails (upright): delta-r = 2 s tan(gamma) exactly, the contacts at the tips; the
+    # shipped synthetic pair (config/profiles: a 1:40 tread and a flange on a crowned head inclined 1:40): the tread's
+    # equivalent conicity is its cone, 0.025, until the flange takes the contact (between 6 and 7 mm), and the chain
+    # delta-r -> equivalent-conicity -> fit-conicity gives a vehicle YAML
+    with tempfile.TemporaryDirectory() as d:
+        wheel = write_file(d, "w.csv", "y_mm,z_mm\n" + "".join(f"{0.1 * k:.1f},{-(0.1 * k - 70) * 0.05:.6f}\n"
+                                                               for k in range(0, 1401)))
+        rail = write_file(d, "r.csv", "y_mm,z_mm\n-20,-50\n0,0\n20,-50\n")
+        r = run_json("delta-r", "--wheel", wheel, "--rail", rail, "--inclination", "0", "--max-shift-mm", "8")
+        assert len(r["y_mm"]) == 161, len(r["y_mm"])
+        for y, dr, cl, cr in zip(r["y_mm"], r["delta_r_mm"], r["contact_left_mm"], r["contact_right_mm"]):
+            close(dr, 2 * y * 0.05, 1e-9, f"delta-r at {y} mm")
+            close(cl, 717.5 + 5.6, 1e-9, "left contact at the tip")
+            close(cr, -(717.5 + 5.6), 1e-9, "right contact at the tip")
+        prof = os.path.join(SRC, "config", "profiles")
+        dr_csv, con_csv, yaml_out = (os.path.join(d, n) for n in ("dr.csv", "con.csv", "fitted.yaml"))
+        run_json("delta-r", "--wheel", os.path.join(prof, "wheel_synthetic.csv"), "--rail",
+                 os.path.join(prof, "rail_synthetic.csv"), "--out", dr_csv)
+        e = run_json("equivalent-conicity", "--delta-r", dr_csv, "--csv-out", con_csv)
+        by = dict(zip((round(a, 1) for a in e["amplitude_mm"]), e["conicity"]))
+        for a in (1.0, 3.0, 6.0):
+            close(by[a], 0.025, 1e-6, f"the 1:40 tread at {a} mm")
+        assert by[7.0] > 0.1, by[7.0]
+        f = run_json("fit-conicity", con_csv, "--y-unit", "mm", "--terms", "2", "--symmetric",
+                     "--write-config", yaml_out)
+        assert abs(f["conicity_at_zero"] - 0.025) < 0.01 and os.path.getsize(yaml_out) > 100, f["conicity_at_zero"]
+        cases = [
+            ([], "give the profiles"),
+            (["--wheel", wheel, "--rail", write_file(d, "h.csv", "y,z\n0,0\n1,1\n2,2\n")], "the header must be 'y_mm,z_mm'"),
+            (["--wheel", write_file(d, "b.csv", "y_mm,z_mm\n0,0\n2,0\n1,0\n"), "--rail", rail],
+             "left wheel profile: y must increase strictly"),
+            (["--wheel", wheel, "--rail", write_file(d, "f.csv", "y_mm,z_mm\n-20,-5\n0,0\n20,-5\n")],
+             "does not reach 14 mm below the top"),
+            (["--wheel", write_file(d, "n.csv", "y_mm,z_mm\n60,0.25\n70,0\n80,-0.25\n"), "--rail", rail],
+             "does not lie over its rail"),
+            (["--wheel", wheel, "--rail", rail, "--inclination", "3"], "--inclination must be 0"),
+            (["--wheel", wheel, "--rail", rail, "--gauge-mm", "1300"], "gauge_m: must exceed"),
+        ]
+        for args, message in cases:
+            p = run("delta-r", *args, ok=False)
+            assert p.returncode != 0 and message in p.stderr and p.stdout == "", (args, p.stderr, p.stdout)
+
+
 def test_json_numbers_round_trip():
     # numbers are written in their shortest form that reads back as the same double: a configured 8.96 MN/m comes
     # out as 8.96, a whole speed without an exponent, and a computed critical speed with every digit it needs (the
