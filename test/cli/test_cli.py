@@ -589,6 +589,17 @@ def test_delta_r_from_profiles_and_the_chain():
         f = run_json("fit-conicity", con_csv, "--y-unit", "mm", "--terms", "2", "--symmetric",
                      "--write-config", yaml_out)
         assert abs(f["conicity_at_zero"] - 0.025) < 0.01 and os.path.getsize(yaml_out) > 100, f["conicity_at_zero"]
+        # the plot of the chain (scripts/plot_eqcon) from the three outputs
+        files = {}
+        for name, args in (("contact.json", ["delta-r", "--wheel", os.path.join(prof, "wheel_synthetic.csv"), "--rail",
+                                             os.path.join(prof, "rail_synthetic.csv")]),
+                           ("eqcon.json", ["equivalent-conicity", "--delta-r", dr_csv]),
+                           ("fit.json", ["fit-conicity", con_csv, "--y-unit", "mm", "--terms", "2", "--symmetric"])):
+            files[name] = write_file(d, name, run(*args).stdout)
+        p = subprocess.run(["/usr/bin/python3", os.path.join(SRC, "scripts", "plot_eqcon"), files["contact.json"],
+                            files["eqcon.json"], files["fit.json"], "--out", os.path.join(d, "chain")],
+                           capture_output=True, text=True)
+        assert p.returncode == 0 and os.path.getsize(os.path.join(d, "chain.png")) > 10000, p.stderr
         cases = [
             ([], "give the profiles"),
             (["--wheel", wheel, "--rail", write_file(d, "h.csv", "y,z\n0,0\n1,1\n2,2\n")], "the header must be 'y_mm,z_mm'"),
