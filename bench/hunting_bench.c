@@ -7,6 +7,7 @@
 
 #include "hunting_monitor/monitor.h"
 #include "hunting_monitor/conicity_fit.h"
+#include "hunting_monitor/contact.h"
 #include "hunting_monitor/eqcon.h"
 #include "hunting_monitor/estimator.h"
 #include "hunting_monitor/cycles.h"
@@ -256,6 +257,34 @@ static void bench_monitor(double *ns_push, double *ns_monitor, double *ns_update
   free(x);
 }
 
+/* delta-r from profiles like the shipped synthetic pair (a 1:40 tread with a flange, 1251 points every 0.1 mm; a
+ * crowned head, 721 points), 161 shifts over +-8 mm, both sides [ms], best of 5. */
+static double bench_delta_r(void) {
+  static double wy[1251], wz[1251], ry[721], rz[721];
+  for (int k = 0; k < 1251; ++k) {
+    wy[k] = 1e-3 * (10.0 + 0.1 * k);
+    wz[k] = 1e-3 * (-(1e3 * wy[k] - 70.0) / 40.0 + 27.3 * (1.0 - tanh((1e3 * wy[k] - 31.0) / 4.0)) / 2.0);
+  }
+  for (int k = 0; k < 721; ++k) {
+    const double y = -36.0 + 0.1 * k, e = fmax(0.0, (fabs(y) - 20.0) / 16.0);
+    ry[k] = 1e-3 * y;
+    rz[k] = 1e-3 * (-y * y / 600.0 - 20.0 * e * e * e);
+  }
+  const hm_profile w = {wy, wz, 1251}, r = {ry, rz, 721};
+  hm_contact_config c;
+  hm_contact_config_default(&c);
+  static double s[161];
+  static hm_contact_point p[161];
+  for (int k = 0; k < 161; ++k) s[k] = 1e-4 * (k - 80);
+  double best = INFINITY;
+  for (int rep = 0; rep < 5; ++rep) {
+    const double t0 = now_s();
+    if (hm_contact_delta_r(&c, &w, NULL, &r, NULL, s, 161, p, NULL, 0) != HM_OK) return NAN;
+    best = fmin(best, now_s() - t0);
+  }
+  return best * 1e3;
+}
+
 /* EN 15302 from a delta-r of 201 points (-10..10 mm every 0.1 mm, a worn profile's cubic rise): the 66 amplitudes
  * 1..7.5 mm by each method, the table's set-up included [ms], best of 5. */
 static void bench_eqcon(double *int_ms, double *reg_ms) {
@@ -340,6 +369,7 @@ int main(void) {
   bench_monitor(&ns_push, &ns_monitor, &ns_update, &us_fit);
   double eq_int_ms = NAN, eq_reg_ms = NAN;
   bench_eqcon(&eq_int_ms, &eq_reg_ms);
+  const double dr_ms = bench_delta_r();
 
   printf("{\n");
   printf("  \"closed_form_critical_speeds_per_s\": %.4g,\n", closed_per_s);
@@ -362,6 +392,7 @@ int main(void) {
   printf("  \"table_lookup_ns\": %.4g,\n", lookup_ns);
   printf("  \"conicity_fit_500_points_3_terms_ms\": %.4g,\n", fit_s * 1e3);
   printf("  \"conicity_fit_rmse\": %.5f,\n", fit_rmse);
+  printf("  \"delta_r_161_shifts_from_profiles_ms\": %.4g,\n", dr_ms);
   printf("  \"equivalent_conicity_66_amplitudes_integration_ms\": %.4g,\n", eq_int_ms);
   printf("  \"equivalent_conicity_66_amplitudes_regression_ms\": %.4g,\n", eq_reg_ms);
   printf("  \"estimator_ns_per_sample\": %.4g,\n", ns_push);

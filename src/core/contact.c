@@ -106,7 +106,7 @@ static hm_status rail_setup(const hm_profile *p, const hm_contact_config *cfg, c
   return HM_EDOMAIN;
 }
 
-/* Linear interpolation in a strictly increasing table given by accessors; x inside [x(0), x(n-1)]. */
+/* The wheel profile at y (inside it) and its slope there. */
 static double wheel_z(const hm_profile *w, double y, double *slope) {
   size_t lo = 0, hi = w->n - 1;
   while (hi - lo > 1) {
@@ -119,38 +119,43 @@ static double wheel_z(const hm_profile *w, double y, double *slope) {
   return w->z_m[lo] + g * (y - w->y_m[lo]);
 }
 
-static double rail_z_at(const rail *r, double u) {
-  size_t lo = 0, hi = r->p->n - 1;
-  while (hi - lo > 1) {
-    const size_t mid = (lo + hi) / 2;
-    if (rail_u(r, mid) <= u) lo = mid;
-    else hi = mid;
-  }
-  const double u0 = rail_u(r, lo), u1 = rail_u(r, lo + 1);
-  return rail_z(r, lo) + (rail_z(r, lo + 1) - rail_z(r, lo)) * (u - u0) / (u1 - u0);
+/* The overlap of the rail and the wheel (at y_w = u + off) in u; 0, or -1 if there is none. */
+static int overlap(const rail *r, const hm_profile *w, double off, double *lo, double *hi) {
+  *lo = fmax(rail_u(r, 0), w->y_m[0] - off);
+  *hi = fmin(rail_u(r, r->p->n - 1), w->y_m[w->n - 1] - off);
+  return *hi >= *lo ? 0 : -1;
 }
 
 /* The contact of a wheel on its rail with the wheel's profile at y_w = u + off: the u maximising
- * z_rail(u) + z_wheel(u + off) over the overlap, tried at every point of both; 0, or -1 without an overlap. */
-static int contact(const rail *r, const hm_profile *w, double off, double *u_best, double *yw_best) {
-  const double lo = fmax(rail_u(r, 0), w->y_m[0] - off), hi = fmin(rail_u(r, r->p->n - 1), w->y_m[w->n - 1] - off);
-  if (!(hi >= lo)) return -1;
-  double best = -INFINITY, bu = lo;
-  for (size_t pass = 0; pass < 2; ++pass) {
-    const size_t n = pass == 0 ? r->p->n : w->n;
-    for (size_t k = 0; k <= n + 1; ++k) {
-      double u;
-      if (k == n) u = lo; /* the overlap's ends too */
-      else if (k == n + 1) u = hi;
-      else u = pass == 0 ? rail_u(r, k) : w->y_m[k] - off;
-      if (u < lo || u > hi) continue;
-      const double f = rail_z_at(r, u) + wheel_z(w, u + off, NULL);
-      if (f > best + 1e-15 || (f >= best - 1e-15 && u > bu)) best = fmax(best, f), bu = u;
+ * z_rail(u) + z_wheel(u + off) over the overlap, tried at every point of both (and the overlap's ends), walking both
+ * in order of u: O(n_rail + n_wheel). The overlap must exist. */
+static void contact(const rail *r, const hm_profile *w, double off, double *u_best, double *yw_best) {
+  double lo, hi;
+  overlap(r, w, off, &lo, &hi);
+  size_t i = 0, j = 0; /* the rail's and the wheel's segments holding u */
+  const size_t nr = r->p->n, nw = w->n;
+  double best = -INFINITY, bu = lo, u = lo;
+  for (;;) {
+    while (i + 2 < nr && rail_u(r, i + 1) <= u) ++i;
+    while (j + 2 < nw && w->y_m[j + 1] - off <= u) ++j;
+    const double u0 = rail_u(r, i), u1 = rail_u(r, i + 1);
+    const double zr = rail_z(r, i) + (rail_z(r, i + 1) - rail_z(r, i)) * (u - u0) / (u1 - u0);
+    const double y = u + off;
+    const double zw = w->z_m[j] + (w->z_m[j + 1] - w->z_m[j]) * (y - w->y_m[j]) / (w->y_m[j + 1] - w->y_m[j]);
+    const double f = zr + zw;
+    if (f > best + 1e-15 || f >= best - 1e-15) { /* ties: the later (field side) point */
+      if (f > best + 1e-15 || u > bu) bu = u;
+      best = fmax(best, f);
     }
+    if (u >= hi) break;
+    /* the next point of either profile beyond u (the segments' ends: past the last segment there is none) */
+    double next = hi;
+    if (u1 > u) next = fmin(next, u1);
+    if (w->y_m[j + 1] - off > u) next = fmin(next, w->y_m[j + 1] - off);
+    u = next > u ? next : hi;
   }
   *u_best = bu;
   *yw_best = bu + off;
-  return 0;
 }
 
 hm_status hm_contact_delta_r(const hm_contact_config *cfg, const hm_profile *wl, const hm_profile *wr,
@@ -172,9 +177,9 @@ hm_status hm_contact_delta_r(const hm_contact_config *cfg, const hm_profile *wl,
   const double c = 0.5 * (cfg->gauge_m - cfg->flange_back_distance_m);
   /* every shift first: a wheel off its rail anywhere is refused before anything is written */
   for (size_t i = 0; i < n_shifts; ++i) {
-    double u, y;
-    if (!isfinite(shifts[i]) || contact(&left, wl, c - shifts[i], &u, &y) != 0 ||
-        contact(&right, wr, c + shifts[i], &u, &y) != 0) {
+    double lo, hi;
+    if (!isfinite(shifts[i]) || overlap(&left, wl, c - shifts[i], &lo, &hi) != 0 ||
+        overlap(&right, wr, c + shifts[i], &lo, &hi) != 0) {
       if (why && len)
         snprintf(why, len, "at a shift of %g mm a wheel does not lie over its rail (the profiles do not overlap)",
                  1e3 * shifts[i]);
