@@ -1,6 +1,6 @@
 /*
  * hunting_monitor - rolling-radius difference delta-r from wheel and rail profiles (rigid single-point contact,
- * roll neglected, as EN 15302's reference cases are computed; issue #19).
+ * roll neglected by default, as EN 15302's reference cases are computed, or included; issue #19).
  *
  * Conventions (all lengths in m here, mm in the CSV files of `hunting delta-r`):
  *  - a wheel profile: y from the wheel's flange back (inner face) toward the field side, z the rolling radius there
@@ -14,10 +14,13 @@
  *  - the track: gauge_m (1435 mm) between the gauge points, the left rail at +gauge/2, lateral Y positive to the left;
  *    the wheelset: the flange backs flange_back_distance_m (1360 mm) apart; shifted by s to the left. The right side
  *    is the mirror image (its own profiles or the left ones).
- * For each shift s, each wheel is lowered onto its rail (no roll: independently): the contact is where wheel and
- * rail surfaces first touch, i.e. where z_wheel(y_w(Y)) + z_rail(Y) is largest over the lateral positions Y where
- * both profiles exist; for piecewise-linear profiles that maximum lies at a point of one of them, and all of those
- * are tried (exact). delta-r(s) = r_left(s) - r_right(s), r = r0 + z_wheel at the contact. Two points of equal height
+ * For each shift s, each wheel is lowered onto its rail (roll neglected: independently): the contact is where
+ * wheel and rail surfaces first touch, i.e. where the axle height the wheel needs over the rail, z_rail(Y) -
+ * z_wheel_below_axle(Y), is largest over the lateral positions Y where both profiles exist; for piecewise-linear
+ * profiles that maximum lies at a point of one of them, and all of those are tried (exact). With include_roll the
+ * rigid wheelset rolls about its centre (within -+0.02 rad) until both wheels need the same axle height: both rest
+ * on their rails (bisection on the roll to 1e-13 rad; the contacts then move by the roll's lateral and vertical
+ * displacement of the profiles). delta-r(s) = r_left(s) - r_right(s), r = r0 + z_wheel at the contact. Two points of equal height
  * (a two-point contact) give the one nearer the field side.
  * Cost: O(n_wheel + n_rail) per shift and side (both profiles walked in order); 161 shifts of a 1251-point wheel
  * on a 721-point rail take 10 ms. No allocation: the caller gives the output arrays.
@@ -45,9 +48,10 @@ typedef struct {
   double gauge_m;                 /* between the rails' gauge points [m] */
   double gauge_depth_m;           /* the gauge point below the rail top [m] */
   double inclination;             /* tan of the rails' inclination toward the track centre (1/40, 1/20, 0) */
+  int include_roll;               /* 1: the rigid wheelset rolls until both wheels rest on their rails */
 } hm_contact_config;
 
-/* 0.46 m both, 70 mm, 1360 mm, 1435 mm, 14 mm, 1/40. */
+/* 0.46 m both, 70 mm, 1360 mm, 1435 mm, 14 mm, 1/40, roll neglected. */
 void hm_contact_config_default(hm_contact_config *cfg);
 /* "field: reason" (HM_EDOMAIN). */
 hm_status hm_contact_config_validate(const hm_contact_config *cfg, char *why, size_t why_len);
@@ -63,6 +67,7 @@ typedef struct {
   double wheel_y_left_m, wheel_y_right_m; /* and on the wheel profiles (y from the flange back) */
   double contact_angle_left_rad, contact_angle_right_rad; /* the wheel profile's slope there, atan(-dz/dy):
                                                              positive where the radius falls toward the field side */
+  double roll_rad;                  /* the wheelset's roll (left side up; 0 with roll neglected) */
 } hm_contact_point;
 
 /* delta-r at shifts[k] (m, to the left), k < n_shifts, into out[k]. The right wheel and rail are the mirror images of

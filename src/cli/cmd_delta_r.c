@@ -22,6 +22,8 @@ const cli_option delta_r_opts[] = {
     {"measuring-circle-mm", "MM", "the measuring circle's y on the wheel profile (default 70)"},
     {"max-shift-mm", "MM", "lateral shifts from -MM to +MM (default 8)"},
     {"step-mm", "MM", "their step (default 0.1)"},
+    {"roll", NULL, "let the rigid wheelset roll until both wheels rest on their rails (default: roll neglected, as in "
+                   "EN 15302's reference cases)"},
     {"out", "FILE", "write y_mm,delta_r_mm for 'hunting equivalent-conicity --delta-r'"},
     {NULL, NULL, NULL}};
 
@@ -81,6 +83,7 @@ int cmd_delta_r(const cli_args *a) {
   c.gauge_depth_m = 1e-3 * depth;
   c.flange_back_distance_m = 1e-3 * fb;
   c.measuring_circle_m = 1e-3 * mc;
+  c.include_roll = cli_has(a, "roll");
   char why[256] = "";
   if (hm_contact_config_validate(&c, why, sizeof why) != HM_OK) {
     fprintf(stderr, "hunting delta-r: %s (in m)\n", why);
@@ -128,6 +131,7 @@ int cmd_delta_r(const cli_args *a) {
   jw_init(&w, stdout);
   jw_object(&w, NULL);
   jw_number(&w, "inclination", c.inclination);
+  jw_bool(&w, "roll_included", c.include_roll);
   jw_number(&w, "gauge_mm", gauge);
   jw_number(&w, "flange_back_mm", fb);
   jw_number(&w, "r0_left_mm", 1e3 * c.r0_left_m);
@@ -144,6 +148,8 @@ int cmd_delta_r(const cli_args *a) {
   jw_numbers(&w, "contact_angle_left_rad", col, n);
   for (size_t k = 0; k < n; ++k) col[k] = p[k].contact_angle_right_rad;
   jw_numbers(&w, "contact_angle_right_rad", col, n);
+  for (size_t k = 0; k < n; ++k) col[k] = p[k].roll_rad;
+  jw_numbers(&w, "roll_rad", col, n);
   jw_end_object(&w);
   jw_finish(&w);
   free(col);

@@ -12,6 +12,7 @@ void hm_contact_config_default(hm_contact_config *cfg) {
   cfg->gauge_m = 1.435;
   cfg->gauge_depth_m = 0.014;
   cfg->inclination = 1.0 / 40.0;
+  cfg->include_roll = 0;
 }
 
 hm_status hm_contact_config_validate(const hm_contact_config *c, char *why, size_t len) {
@@ -31,6 +32,10 @@ hm_status hm_contact_config_validate(const hm_contact_config *c, char *why, size
       if (why && len) snprintf(why, len, "%s: must be in [%g, %g] (got %g)", f[i].name, f[i].lo, f[i].hi, f[i].v);
       return HM_EDOMAIN;
     }
+  if (c->include_roll != 0 && c->include_roll != 1) {
+    if (why && len) snprintf(why, len, "include_roll: must be 0 or 1 (got %d)", c->include_roll);
+    return HM_EDOMAIN;
+  }
   if (!(c->gauge_m > c->flange_back_distance_m)) {
     if (why && len)
       snprintf(why, len, "gauge_m: must exceed flange_back_distance_m (got %g and %g)", c->gauge_m,
@@ -119,44 +124,69 @@ static double wheel_z(const hm_profile *w, double y, double *slope) {
   return w->z_m[lo] + g * (y - w->y_m[lo]);
 }
 
-/* The overlap of the rail and the wheel (at y_w = u + off) in u; 0, or -1 if there is none. */
-static int overlap(const rail *r, const hm_profile *w, double off, double *lo, double *hi) {
-  *lo = fmax(rail_u(r, 0), w->y_m[0] - off);
-  *hi = fmin(rail_u(r, r->p->n - 1), w->y_m[w->n - 1] - off);
+/* A wheel over its rail: the wheelset shifted by s (to the left) and rolled by phi (the left side up) about its centre
+ * on the axle; side +1 left, -1 right. Its profile's point k in the rail's coordinate u (from the gauge point, field
+ * side +) and its height below the axle (negative), so that the axle must be at least z_rail(u) - zrel(u) high. */
+typedef struct {
+  const hm_profile *w;
+  double sign, r0, half_fb, half_g, s, c, sn; /* cos and sin of the roll */
+} wheel;
+
+static double wheel_u(const wheel *w, size_t k) {
+  const double yw = w->sign * (w->half_fb + w->w->y_m[k]), zw = -(w->r0 + w->w->z_m[k]);
+  return w->sign * (yw * w->c - zw * w->sn + w->s) - w->half_g;
+}
+static double wheel_zrel(const wheel *w, size_t k) {
+  const double yw = w->sign * (w->half_fb + w->w->y_m[k]), zw = -(w->r0 + w->w->z_m[k]);
+  return yw * w->sn + zw * w->c;
+}
+
+/* The overlap of the rail and the wheel in u; 0, or -1 if there is none (or the rolled wheel is not a function of
+ * u, a flank steeper than the roll allows). */
+static int overlap(const rail *r, const wheel *w, double *lo, double *hi) {
+  for (size_t k = 1; k < w->w->n; ++k)
+    if (!(wheel_u(w, k) > wheel_u(w, k - 1))) return -1;
+  *lo = fmax(rail_u(r, 0), wheel_u(w, 0));
+  *hi = fmin(rail_u(r, r->p->n - 1), wheel_u(w, w->w->n - 1));
   return *hi >= *lo ? 0 : -1;
 }
 
-/* The contact of a wheel on its rail with the wheel's profile at y_w = u + off: the u maximising
- * z_rail(u) + z_wheel(u + off) over the overlap, tried at every point of both (and the overlap's ends), walking both
- * in order of u: O(n_rail + n_wheel). The overlap must exist. */
-static void contact(const rail *r, const hm_profile *w, double off, double *u_best, double *yw_best) {
+/* The contact: the u maximising z_rail(u) - zrel(u) over the overlap (the height the axle needs there), tried at
+ * every point of both profiles and the overlap's ends, walking both in order of u: O(n_rail + n_wheel). The
+ * overlap must exist. The height, u and the wheel profile's y there. */
+static void contact(const rail *r, const wheel *w, double *height, double *u_best, double *yw_best) {
   double lo, hi;
-  overlap(r, w, off, &lo, &hi);
+  overlap(r, w, &lo, &hi);
   size_t i = 0, j = 0; /* the rail's and the wheel's segments holding u */
-  const size_t nr = r->p->n, nw = w->n;
-  double best = -INFINITY, bu = lo, u = lo;
+  const size_t nr = r->p->n, nw = w->w->n;
+  double best = -INFINITY, bu = lo, by = 0.0, u = lo;
   for (;;) {
     while (i + 2 < nr && rail_u(r, i + 1) <= u) ++i;
-    while (j + 2 < nw && w->y_m[j + 1] - off <= u) ++j;
-    const double u0 = rail_u(r, i), u1 = rail_u(r, i + 1);
+    while (j + 2 < nw && wheel_u(w, j + 1) <= u) ++j;
+    const double u0 = rail_u(r, i), u1 = rail_u(r, i + 1), v0 = wheel_u(w, j), v1 = wheel_u(w, j + 1);
     const double zr = rail_z(r, i) + (rail_z(r, i + 1) - rail_z(r, i)) * (u - u0) / (u1 - u0);
-    const double y = u + off;
-    const double zw = w->z_m[j] + (w->z_m[j + 1] - w->z_m[j]) * (y - w->y_m[j]) / (w->y_m[j + 1] - w->y_m[j]);
-    const double f = zr + zw;
-    if (f > best + 1e-15 || f >= best - 1e-15) { /* ties: the later (field side) point */
-      if (f > best + 1e-15 || u > bu) bu = u;
+    const double t = (u - v0) / (v1 - v0);
+    const double zw = wheel_zrel(w, j) + (wheel_zrel(w, j + 1) - wheel_zrel(w, j)) * t;
+    const double f = zr - zw;
+    if (f > best + 1e-15 || (f >= best - 1e-15 && u > bu)) { /* ties: the later (field side) point */
       best = fmax(best, f);
+      bu = u;
+      by = w->w->y_m[j] + (w->w->y_m[j + 1] - w->w->y_m[j]) * t;
     }
     if (u >= hi) break;
     /* the next point of either profile beyond u (the segments' ends: past the last segment there is none) */
     double next = hi;
     if (u1 > u) next = fmin(next, u1);
-    if (w->y_m[j + 1] - off > u) next = fmin(next, w->y_m[j + 1] - off);
+    if (v1 > u) next = fmin(next, v1);
     u = next > u ? next : hi;
   }
+  *height = best;
   *u_best = bu;
-  *yw_best = bu + off;
+  *yw_best = by;
 }
+
+/* The roll the wheelset takes when both wheels rest on their rails is within -+ this [rad]. */
+#define MAX_ROLL_RAD 0.02
 
 hm_status hm_contact_delta_r(const hm_contact_config *cfg, const hm_profile *wl, const hm_profile *wr,
                              const hm_profile *rl, const hm_profile *rr, const double *shifts, size_t n_shifts,
@@ -174,23 +204,58 @@ hm_status hm_contact_delta_r(const hm_contact_config *cfg, const hm_profile *wl,
   st = rail_setup(rl, cfg, "left", &left, why, len);
   if (st == HM_OK) st = rail_setup(rr, cfg, "right", &right, why, len);
   if (st != HM_OK) return st;
-  const double c = 0.5 * (cfg->gauge_m - cfg->flange_back_distance_m);
-  /* every shift first: a wheel off its rail anywhere is refused before anything is written */
+  wheel L = {wl, 1.0, cfg->r0_left_m, 0.5 * cfg->flange_back_distance_m, 0.5 * cfg->gauge_m, 0.0, 1.0, 0.0};
+  wheel R = {wr, -1.0, cfg->r0_right_m, 0.5 * cfg->flange_back_distance_m, 0.5 * cfg->gauge_m, 0.0, 1.0, 0.0};
+  /* every shift first (with roll: at both ends of the roll's range, and a root between): a wheel off its rail
+   * anywhere is refused before anything is written */
   for (size_t i = 0; i < n_shifts; ++i) {
-    double lo, hi;
-    if (!isfinite(shifts[i]) || overlap(&left, wl, c - shifts[i], &lo, &hi) != 0 ||
-        overlap(&right, wr, c + shifts[i], &lo, &hi) != 0) {
+    double lo, hi, hl, hr, u, y;
+    int bad = !isfinite(shifts[i]);
+    L.s = R.s = shifts[i];
+    for (int e = cfg->include_roll ? -1 : 0; !bad && e <= (cfg->include_roll ? 1 : 0); e += 2) {
+      L.c = R.c = cos(e * MAX_ROLL_RAD);
+      L.sn = R.sn = sin(e * MAX_ROLL_RAD);
+      bad = overlap(&left, &L, &lo, &hi) != 0 || overlap(&right, &R, &lo, &hi) != 0;
+      if (!bad && cfg->include_roll) {
+        contact(&left, &L, &hl, &u, &y);
+        contact(&right, &R, &hr, &u, &y);
+        bad = e < 0 ? !(hl >= hr) : !(hl <= hr); /* the left side's need falls as it rolls up */
+      }
+      if (!cfg->include_roll) break;
+    }
+    if (bad) {
       if (why && len)
-        snprintf(why, len, "at a shift of %g mm a wheel does not lie over its rail (the profiles do not overlap)",
+        snprintf(why, len,
+                 cfg->include_roll ? "at a shift of %g mm the wheels do not rest on both rails within a roll of "
+                                     "-+0.02 rad (or a wheel does not lie over its rail)"
+                                   : "at a shift of %g mm a wheel does not lie over its rail (the profiles do not "
+                                     "overlap)",
                  1e3 * shifts[i]);
       return HM_EDOMAIN;
     }
   }
   for (size_t i = 0; i < n_shifts; ++i) {
     hm_contact_point p;
-    double ul, ur, gl, gr;
-    contact(&left, wl, c - shifts[i], &ul, &p.wheel_y_left_m);
-    contact(&right, wr, c + shifts[i], &ur, &p.wheel_y_right_m);
+    double ul, ur, hl, hr, gl, gr, phi = 0.0;
+    L.s = R.s = shifts[i];
+    if (cfg->include_roll) { /* both wheels on their rails: the roll where the axle heights they need agree */
+      double a = -MAX_ROLL_RAD, b = MAX_ROLL_RAD;
+      for (int it = 0; it < 80 && b - a > 1e-13; ++it) {
+        phi = 0.5 * (a + b);
+        L.c = R.c = cos(phi);
+        L.sn = R.sn = sin(phi);
+        contact(&left, &L, &hl, &ul, &p.wheel_y_left_m);
+        contact(&right, &R, &hr, &ur, &p.wheel_y_right_m);
+        if (hl > hr) a = phi;
+        else b = phi;
+      }
+      phi = 0.5 * (a + b);
+    }
+    L.c = R.c = cos(phi);
+    L.sn = R.sn = sin(phi);
+    contact(&left, &L, &hl, &ul, &p.wheel_y_left_m);
+    contact(&right, &R, &hr, &ur, &p.wheel_y_right_m);
+    p.roll_rad = phi;
     p.r_left_m = cfg->r0_left_m + wheel_z(wl, p.wheel_y_left_m, &gl);
     p.r_right_m = cfg->r0_right_m + wheel_z(wr, p.wheel_y_right_m, &gr);
     p.delta_r_m = p.r_left_m - p.r_right_m;

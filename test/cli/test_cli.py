@@ -586,6 +586,17 @@ def test_delta_r_from_profiles_and_the_chain():
         for a in (1.0, 3.0, 6.0):
             close(by[a], 0.025, 1e-6, f"the 1:40 tread at {a} mm")
         assert by[7.0] > 0.1, by[7.0]
+        # with the roll (--roll) on the symmetric pair: no roll at zero shift, delta-r odd in the shift, and the
+        # wheelset rolls toward the side whose radius grew, by about delta-r / the contacts' distance
+        rolled = run_json("delta-r", "--wheel", os.path.join(prof, "wheel_synthetic.csv"), "--rail",
+                          os.path.join(prof, "rail_synthetic.csv"), "--roll", "--max-shift-mm", "5")
+        mid = len(rolled["y_mm"]) // 2
+        assert rolled["roll_included"] and abs(rolled["roll_rad"][mid]) < 1e-9, rolled["roll_rad"][mid]
+        for k in range(1, mid + 1):
+            close(rolled["delta_r_mm"][mid + k], -rolled["delta_r_mm"][mid - k], 1e-6, "odd delta-r with roll")
+            dist = rolled["contact_left_mm"][mid + k] - rolled["contact_right_mm"][mid + k]
+            close(rolled["roll_rad"][mid + k], rolled["delta_r_mm"][mid + k] / dist, 0.02 * abs(rolled["roll_rad"][mid + k]) + 1e-9,
+                  "roll from delta-r")
         f = run_json("fit-conicity", con_csv, "--y-unit", "mm", "--terms", "2", "--symmetric",
                      "--write-config", yaml_out)
         assert abs(f["conicity_at_zero"] - 0.025) < 0.01 and os.path.getsize(yaml_out) > 100, f["conicity_at_zero"]
@@ -611,6 +622,8 @@ def test_delta_r_from_profiles_and_the_chain():
              "does not lie over its rail"),
             (["--wheel", wheel, "--rail", rail, "--inclination", "3"], "--inclination must be 0"),
             (["--wheel", wheel, "--rail", rail, "--gauge-mm", "1300"], "gauge_m: must exceed"),
+            (["--wheel", write_file(d, "n2.csv", "y_mm,z_mm\n60,0.25\n70,0\n80,-0.25\n"), "--rail", rail, "--roll"],
+             "do not rest on both rails"),
         ]
         for args, message in cases:
             p = run("delta-r", *args, ok=False)

@@ -1,5 +1,5 @@
 /* libFuzzer harness: delta-r from arbitrary wheel and rail profiles (contact.h): the input split into a wheel and a
- * rail of (y, z) doubles after a byte choosing the inclination. Either a refusal or finite radii, contacts on the
+ * rail of (y, z) doubles after a byte choosing the inclination and the roll. Either a refusal or finite radii, contacts on the
  * track; the out array untouched on refusal. */
 #include <math.h>
 #include <stdint.h>
@@ -22,6 +22,7 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size) {
   hm_contact_config c;
   hm_contact_config_default(&c);
   c.inclination = (data[0] % 3) / 40.0;
+  c.include_roll = (data[0] >> 2) & 1;
   const hm_profile wp = {w[0], w[1], nw}, rp = {r[0], r[1], nr};
   const double s[3] = {-0.008, 0.0, 0.008};
   hm_contact_point p[3];

@@ -121,6 +121,40 @@ static void circle_on_circle(void) {
          worst_c);
 }
 
+/* With the roll (include_roll): the cone on knife edges with radii 460 / 459 mm. The rigid wheelset rests on both
+ * tips (Y = -+a, a = 723.1 mm), so its roll is (r_left - r_right) / (2 a) at the radii where it touches, to first
+ * order (to 1e-3 of it); rolled, the wheels touch the tips at points moved by the roll's lateral displacement
+ * r phi (so delta-r differs from the unrolled one by 2 r phi tan(gamma), to 1e-2 of that: the next order); and equal radii at zero
+ * shift give no roll (1e-12 rad). */
+static void roll_rests_both_wheels(void) {
+  const double tan_g = 0.05, a = 0.7175 + 0.0056;
+  const hm_profile w = cone_wheel(tan_g), r = knife_rail();
+  hm_contact_config c = upright();
+  c.include_roll = 1;
+  c.r0_right_m = 0.459;
+  double s[5] = {-0.004, -0.002, 0.0, 0.002, 0.004};
+  hm_contact_point p[5], q[5];
+  char why[200] = "";
+  HM_CHECK(hm_contact_delta_r(&c, &w, NULL, &r, NULL, s, 5, p, why, sizeof why) == HM_OK, "%s", why);
+  const double roll_at_0 = p[2].roll_rad, dr_at_0 = p[2].r_left_m - p[2].r_right_m;
+  c.include_roll = 0;
+  HM_CHECK(hm_contact_delta_r(&c, &w, NULL, &r, NULL, s, 5, q, why, sizeof why) == HM_OK, "%s", why);
+  for (int k = 0; k < 5; ++k) {
+    HM_CHECK_REL(p[k].roll_rad, (p[k].r_left_m - p[k].r_right_m) / (2.0 * a), 1e-3, "roll");
+    HM_CHECK(q[k].roll_rad == 0.0, "no roll without include_roll");
+    const double expected = q[k].delta_r_m + 2.0 * 0.4595 * p[k].roll_rad * tan_g;
+    HM_CHECK(fabs(p[k].delta_r_m - expected) <= 1e-2 * fabs(expected - q[k].delta_r_m), "rolled delta-r %.9g vs %.9g",
+             p[k].delta_r_m, expected);
+  }
+  c.include_roll = 1;
+  c.r0_right_m = 0.46;
+  HM_CHECK(hm_contact_delta_r(&c, &w, NULL, &r, NULL, s + 2, 1, p, why, sizeof why) == HM_OK &&
+               fabs(p[0].roll_rad) < 1e-12,
+           "symmetric: roll %g", p[0].roll_rad);
+  printf("  roll: 460 / 459 mm radii on knife edges roll the wheelset by %.4e rad at zero shift (r_l - r_r / 2a "
+         "%.4e)\n", roll_at_0, dr_at_0 / (2.0 * a));
+}
+
 /* Bad input: named one-line reasons, out untouched. */
 static void bad_input(void) {
   const hm_profile w = cone_wheel(0.05), r = knife_rail();
@@ -153,6 +187,7 @@ static void bad_input(void) {
 int main(void) {
   HM_RUN(cone_on_knife_edges);
   HM_RUN(circle_on_circle);
+  HM_RUN(roll_rests_both_wheels);
   HM_RUN(bad_input);
   HM_TEST_EXIT();
 }
