@@ -56,8 +56,8 @@ void hm_eqcon_config_default(hm_eqcon_config *cfg);
 /* "field: reason" in why (HM_EDOMAIN): r0_m in (0, 5], contact_distance_m in (0, 5], tol in [1e-14, 1e-2]. */
 hm_status hm_eqcon_config_validate(const hm_eqcon_config *cfg, char *why, size_t why_len);
 
-/* A delta-r table: n >= 3 points, finite, y strictly increasing, a restoring equilibrium (delta-r rising through
- * zero) inside. HM_EINVAL for NULL, HM_EDOMAIN with the reason (and the point) in why. */
+/* A delta-r table: n >= 3 points, finite and within -+100 mm, y strictly increasing by at least 1 nm, a restoring
+ * equilibrium (delta-r rising through zero) inside. HM_EINVAL for NULL, HM_EDOMAIN with the reason (and the point) in why. */
 hm_status hm_eqcon_check(const double *y_m, const double *delta_r_m, size_t n, char *why, size_t why_len);
 
 typedef struct hm_eqcon_s *hm_eqcon;
@@ -77,8 +77,9 @@ typedef struct {
   double equilibrium_m;  /* y_eq */
 } hm_eqcon_result;
 
-/* tan gamma_e at amplitude_m > 0 by the method. HM_EDOMAIN if the oscillation leaves the table (undefined there) or
- * for a bad amplitude or method; HM_ENOCONV if a quadrature does not reach tol; out untouched on failure. Cost:
+/* tan gamma_e at amplitude_m (1e-7 .. 0.1 m) by the method. HM_EDOMAIN if the oscillation leaves the table
+ * (undefined there) or for a bad amplitude or method; HM_ENOCONV if a quadrature does not reach tol, HM_ENONFINITE
+ * if the result is not finite; out untouched on failure. Cost:
  * O(log n) per integrand evaluation, about 1e4-1e5 of them. */
 hm_status hm_eqcon_at(const hm_eqcon e, hm_eqcon_method method, double amplitude_m, hm_eqcon_result *out);
 

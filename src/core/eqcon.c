@@ -58,6 +58,14 @@ hm_status hm_eqcon_check(const double *y, const double *dr, size_t n, char *why,
         snprintf(why, why_len, "delta-r: y must increase strictly (point %zu: %g after %g)", k + 1, y[k], y[k - 1]);
       return HM_EDOMAIN;
     }
+    if (fabs(y[k]) > 0.1 || fabs(dr[k]) > 0.1 || (k > 0 && y[k] - y[k - 1] < 1e-9)) {
+      if (why && why_len)
+        snprintf(why, why_len,
+                 "delta-r: point %zu (%g, %g mm) lies beyond -+100 mm or closer than 1 nm to the previous one: not a "
+                 "wheelset's delta-r in metres",
+                 k + 1, 1e3 * y[k], 1e3 * dr[k]);
+      return HM_EDOMAIN;
+    }
   }
   double y_eq;
   if (equilibrium(y, dr, n, &y_eq) != 0) {
@@ -237,7 +245,8 @@ static double harm_integrand(const table *t, const void *p, double phi) {
 
 hm_status hm_eqcon_at(const hm_eqcon t, hm_eqcon_method method, double amplitude_m, hm_eqcon_result *out) {
   if (!t || !out) return HM_EINVAL;
-  if (!(amplitude_m > 0.0) || !isfinite(amplitude_m) || (method != HM_EQCON_INTEGRATION && method != HM_EQCON_REGRESSION))
+  if (!(amplitude_m >= 1e-7 && amplitude_m <= 0.1) ||
+      (method != HM_EQCON_INTEGRATION && method != HM_EQCON_REGRESSION))
     return HM_EDOMAIN;
   const double *y = t->y, tol = t->cfg.tol;
   const size_t n = t->n;
@@ -255,6 +264,7 @@ hm_status hm_eqcon_at(const hm_eqcon t, hm_eqcon_method method, double amplitude
     r.wavelength_m = r.tan_gamma_e > 0.0 ? 2.0 * PI * sqrt(e0r0 / r.tan_gamma_e) : INFINITY;
     r.y_low_m = t->y_eq - amplitude_m;
     r.y_high_m = t->y_eq + amplitude_m;
+    if (!isfinite(r.tan_gamma_e) || !(r.wavelength_m > 0.0)) return HM_ENONFINITE;
     *out = r;
     return HM_OK;
   }
@@ -303,6 +313,7 @@ hm_status hm_eqcon_at(const hm_eqcon t, hm_eqcon_method method, double amplitude
   r.tan_gamma_e = e0r0 * pow(2.0 * PI / r.wavelength_m, 2.0);
   r.y_low_m = ylo;
   r.y_high_m = yhi;
+  if (!isfinite(r.tan_gamma_e) || !(r.wavelength_m > 0.0)) return HM_ENONFINITE;
   *out = r;
   return HM_OK;
 }
