@@ -3,8 +3,10 @@
  * tables (docs/MODEL.md sections 4-7, issue #9).
  *
  * The conicity in use and the Hopf interval [hopf_low, hopf_high] the level uses come from what is known:
- *  - identified: the margin's model-based estimate (margin.h) with a standard error of at most conicity_max_se: its
- *    conicity and interval (the conicity -+ interval_z standard errors);
+ *  - identified: the margin's model-based estimate (margin.h) with a standard error of at most conicity_max_se (once
+ *    used, up to HM_ALARM_SE_HYSTERESIS times that: an error wandering about the limit as windows come and go does
+ *    not switch the interval, and the level, back and forth): its conicity and interval (the conicity -+
+ *    interval_z standard errors);
  *  - before that, the prior: conicity_fallback (0: the vehicle's own lambda(0)) within the range the wheels may have
  *    worn to, [conicity_prior_low, conicity_prior_high] (0: the fallback -+ HM_ALARM_PRIOR_HALFWIDTH): the interval is
  *    the closed-form Hopf speeds at the range's ends (widened to hold the table's value at the fallback), never the
@@ -126,6 +128,8 @@ typedef struct {
 /* The prior's default half-width: new to worn wheels of a high-speed fleet move lambda(0) by about this (the default
  * vehicle's measured 0.1358 to the issue's worn 0.16 is 0.024). */
 #define HM_ALARM_PRIOR_HALFWIDTH 0.03
+/* An estimate in use stays in use while its standard error is at most this times conicity_max_se. */
+#define HM_ALARM_SE_HYSTERESIS 1.25
 /* The model-free interval's lower end counts for the level from this many windows on (and with model_mismatch). */
 #define HM_ALARM_FREE_MIN_WINDOWS 3u
 

@@ -24,6 +24,7 @@ struct hm_alarm_s {
   double calm_since;
   double displacement_limit_m; /* the displacement criterion's limit (0: off) */
   double hunted_at_kmh;   /* the lowest speed at which a criterion was met during the latch (INFINITY: none) */
+  int precise;            /* the estimate was used alone at the last update with data (its hysteresis) */
   /* the last table lookups (at the conicity in use and at the interval's optimistic end), reused while their
    * conicity and the speed are unchanged */
   struct {
@@ -171,6 +172,7 @@ void hm_alarm_reset(hm_alarm a) {
   a->lower_pending = 0;
   a->latched = a->calm = 0;
   a->hunted_at_kmh = INFINITY;
+  a->precise = 0;
   a->cache[0].valid = a->cache[1].valid = 0;
 }
 
@@ -266,7 +268,8 @@ static hm_status assess(hm_alarm a, const hm_estimate *e, const hm_margin_estima
   const hm_alarm_config *c = &a->cfg;
   const int have = c->use_conicity_estimate && g && g->conicity_valid && g->hopf_model_valid;
   /* a vehicle that does not behave like its model gets no model-based interval narrower than the prior */
-  const int precise = have && g->conicity_se <= c->conicity_max_se && !g->model_mismatch;
+  const double max_se = a->precise ? HM_ALARM_SE_HYSTERESIS * c->conicity_max_se : c->conicity_max_se;
+  const int precise = have && g->conicity_se <= max_se && !g->model_mismatch;
   /* the prior's interval, and the uncertain estimate's where it is the more cautious */
   double lambda = c->conicity_fallback, lambda_opt = c->conicity_prior_low;
   double lo = a->prior_hopf_low_kmh, hi = a->prior_hopf_high_kmh;
@@ -316,6 +319,7 @@ static hm_status assess(hm_alarm a, const hm_estimate *e, const hm_margin_estima
     if (st != HM_OK) return st;
     s->edge_used_m = bo.origin_stable && bo.has_edge ? bo.edge_amp_m : 0.0;
   }
+  a->precise = precise;
   return HM_OK;
 }
 

@@ -327,6 +327,25 @@ static void levels_with_a_conicity_estimate(void) {
              hm_level_name(s.level));
     hm_alarm_destroy(a);
   }
+  /* the estimate's use has a hysteresis: a new alarm refuses 0.011 (above conicity_max_se 0.01); one that used 0.009
+   * keeps it at 0.011 and 0.0124, and leaves it at 0.0126 (above 1.25 x 0.01) */
+  {
+    hm_margin_estimate h = g;
+    e = estimate(400.0, 0.0);
+    a = make();
+    h.conicity_se = 0.011;
+    HM_CHECK(hm_alarm_update(a, &e, &h, 0.0, &s) == HM_OK && !s.conicity_from_estimate, "0.011 at first: refused");
+    hm_alarm_destroy(a);
+    a = make();
+    const double ses[4] = {0.009, 0.011, 0.0124, 0.0126};
+    const int used[4] = {1, 1, 1, 0};
+    for (int k = 0; k < 4; ++k) {
+      h.conicity_se = ses[k];
+      HM_CHECK(hm_alarm_update(a, &e, &h, 0.1 * k, &s) == HM_OK && s.conicity_from_estimate == used[k],
+               "se %g after the others: from estimate %d", ses[k], s.conicity_from_estimate);
+    }
+    hm_alarm_destroy(a);
+  }
   e = estimate(400.0, 0.0);
   hm_margin_estimate mismatch = g;
   mismatch.model_mismatch = 1;
