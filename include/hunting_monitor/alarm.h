@@ -48,7 +48,8 @@
  * below the Hopf speed on a vehicle with conicity 0.16 (issue #18).
  * Thresholds of the current (or a higher) level are relaxed by the hysteresis (hysteresis_kmh on speeds,
  * hysteresis_amplitude_fraction of the edge on amplitudes), a higher level is taken at once, and a lower one only
- * after the conditions for it have held for min_hold_s: no chatter. Every change carries a reason code.
+ * after the conditions for it have held for min_hold_s, and only if they would still hold at the speed the present
+ * acceleration (averaged over HM_ALARM_TREND_S) reaches in HM_ALARM_LOWER_LOOKAHEAD_S: no chatter, also on a ramp. Every change carries a reason code.
  * Latching by cause (issue #21): an ALARM from the oscillation (a criterion, or the amplitude at or beyond the
  * unstable cycle) is latched: it holds, with its reason, until the oscillation has stayed calm for release_s (no
  * criterion met, the displacement amplitude below release_amplitude_fraction of the displacement criterion's limit,
@@ -128,6 +129,10 @@ typedef struct {
 /* The prior's default half-width: new to worn wheels of a high-speed fleet move lambda(0) by about this (the default
  * vehicle's measured 0.1358 to the issue's worn 0.16 is 0.024). */
 #define HM_ALARM_PRIOR_HALFWIDTH 0.03
+/* The speed's trend is averaged over this [s]; a lower level is refused if the speed it reaches in the lookahead
+ * [s] at that trend would call for the present level again (no level down and up again within 30 s on a ramp). */
+#define HM_ALARM_TREND_S 5.0
+#define HM_ALARM_LOWER_LOOKAHEAD_S 30.0
 /* An estimate in use stays in use while its standard error is at most this times conicity_max_se. */
 #define HM_ALARM_SE_HYSTERESIS 1.25
 /* The model-free interval's lower end counts for the level from this many windows on (and with model_mismatch). */

@@ -42,16 +42,26 @@ double hm_track_at(const hm_track track, double s_m);
 double hm_track_rms_m(const hm_track track);
 double hm_track_spectrum_rms_m(double wavelength_min_m, double wavelength_max_m, double scale);
 
+/* Points of a piecewise-linear speed profile at most. */
+#define HM_SPEED_PROFILE_MAX 16
+
 typedef struct {
   hm_model model;                /* vehicle; its speed is set from the profile at each evaluation */
   hm_track track;                /* borrowed; may be NULL: a perfect track */
-  double v_start_kmh, v_end_kmh; /* speed ramps linearly from v_start to v_end over ramp_s, then stays */
-  double ramp_s;
+  /* the speed: linear between the points (t [s], v [km/h]), constant before the first and after the last; the
+   * distance run at each point [m] (exact: trapezoids) */
+  size_t n_profile;
+  double profile_t_s[HM_SPEED_PROFILE_MAX], profile_v_kmh[HM_SPEED_PROFILE_MAX], profile_s_m[HM_SPEED_PROFILE_MAX];
 } hm_excited_model;
 
-/* Fill em (validates the vehicle and speeds > 0; ramp_s >= 0). track is borrowed. */
+/* Fill em with a ramp from v_start to v_end over ramp_s, then steady (validates the vehicle and speeds > 0; ramp_s
+ * >= 0). track is borrowed. */
 hm_status hm_excited_model_init(hm_excited_model *em, const hm_vehicle *veh, const hm_track track,
                                 double v_start_kmh, double v_end_kmh, double ramp_s);
+/* The same with a profile of n points (1..HM_SPEED_PROFILE_MAX; times increasing from 0, speeds > 0): steps are two
+ * points close in time, holds two points at one speed. HM_EDOMAIN for an invalid one. */
+hm_status hm_excited_model_init_profile(hm_excited_model *em, const hm_vehicle *veh, const hm_track track,
+                                        const double *t_s, const double *v_kmh, size_t n);
 double hm_excited_speed_kmh(const hm_excited_model *em, double t_s);
 double hm_excited_distance_m(const hm_excited_model *em, double t_s);
 /* Right-hand side (an hm_ode_fn with params = hm_excited_model *; the model's speed field is updated). */

@@ -14,6 +14,7 @@
 #include <stddef.h>
 #include <stdint.h>
 
+#include "hunting_monitor/excitation.h"
 #include "hunting_monitor/model.h"
 #include "hunting_monitor/status.h"
 
@@ -24,6 +25,9 @@ extern "C" {
 typedef struct {
   double v_start_kmh, v_end_kmh;  /* the speed ramps linearly from v_start to v_end over ramp_s, then stays */
   double ramp_s;
+  /* or, with n_profile >= 1, the speed profile instead (excitation.h): linear between the points, times from 0 */
+  size_t n_profile;
+  double profile_t_s[HM_SPEED_PROFILE_MAX], profile_v_kmh[HM_SPEED_PROFILE_MAX];
   double irregularity_scale;      /* power of the German low-disturbance spectrum times this (0: a perfect track) */
   double wavelength_min_m, wavelength_max_m; /* the irregularity's band: 3 and 120 m */
   uint64_t track_seed;            /* the track's random amplitudes */

@@ -125,6 +125,7 @@ static int cmd_eig(const cli_args *a) {
 static const cli_option simulate_opts[] = {
     {"v", "KM/H", "running speed (required; the start speed with --v-end)"},
     {"v-end", "KM/H", "ramp the speed linearly from --v to this over --t"},
+    {"profile", "T:V,T:V,...", "a speed profile instead (s:km/h, linear between, from 0 s; up to 16 points; --v not needed)"},
     {"x0", "Y,DY,PSI,DPSI", "initial state [m, m/s, rad, rad/s] (default 0.001,0,0,0)"},
     {"t", "SECONDS", "simulated time (default 10)"},
     {"dt-out", "SECONDS", "output interval, dense output of the integrator (default 0.001)"},
@@ -193,11 +194,42 @@ static int close_outputs(const cli_args *a, FILE *out, FILE *acc, FILE *spd) {
   return rc;
 }
 
+/* "T:V,T:V,..." into the profile; 0, or 1 with the message printed. */
+static int parse_profile(const char *s, double *t, double *v, size_t *n) {
+  size_t k = 0;
+  const char *p = s;
+  while (*p) {
+    char *end = NULL;
+    if (k == HM_SPEED_PROFILE_MAX) break;
+    t[k] = strtod(p, &end);
+    if (end == p || *end != ':') break;
+    p = end + 1;
+    v[k] = strtod(p, &end);
+    if (end == p || !isfinite(t[k]) || !isfinite(v[k])) break;
+    ++k;
+    p = end;
+    if (*p == ',') ++p;
+    else if (*p) break;
+  }
+  if (*p || k == 0) {
+    fprintf(stderr, "hunting simulate: --profile must be T:V,T:V,... (s:km/h, up to %d points), got '%s'\n",
+            HM_SPEED_PROFILE_MAX, s);
+    return 1;
+  }
+  *n = k;
+  return 0;
+}
+
 static int cmd_simulate(const cli_args *a) {
   hm_vehicle veh, lin;
-  double v_kmh, x[4] = {0.001, 0.0, 0.0, 0.0}, t_end = 10.0, dt_out = 0.001, rtol = 1e-9, atol = 1e-12;
+  double v_kmh = 0.0, x[4] = {0.001, 0.0, 0.0, 0.0}, t_end = 10.0, dt_out = 0.001, rtol = 1e-9, atol = 1e-12;
   double v_end = NAN, scale = 0.0, seed = 1.0, noise = 0.0;
-  if (cli_vehicle(a, &veh, NULL) || cli_speed_option(a, &v_kmh) || cli_number_list(a, "x0", x, 4) ||
+  double prof_t[HM_SPEED_PROFILE_MAX], prof_v[HM_SPEED_PROFILE_MAX];
+  size_t n_prof = 0;
+  const char *profile = cli_value(a, "profile");
+  if (profile && parse_profile(profile, prof_t, prof_v, &n_prof)) return 1;
+  if (profile) v_kmh = prof_v[0];
+  if (cli_vehicle(a, &veh, NULL) || (!profile && cli_speed_option(a, &v_kmh)) || cli_number_list(a, "x0", x, 4) ||
       cli_number(a, "t", &t_end) || cli_number(a, "dt-out", &dt_out) || cli_number(a, "rtol", &rtol) ||
       cli_number(a, "atol", &atol) || cli_number(a, "v-end", &v_end) || cli_number(a, "irregularity", &scale) ||
       cli_number(a, "seed", &seed) || cli_number(a, "accel-noise", &noise))
@@ -219,6 +251,8 @@ static int cmd_simulate(const cli_args *a) {
   cfg.v_start_kmh = v_kmh;
   cfg.v_end_kmh = v_end;
   cfg.ramp_s = t_end;
+  cfg.n_profile = n_prof;
+  for (size_t k = 0; k < n_prof; ++k) cfg.profile_t_s[k] = prof_t[k], cfg.profile_v_kmh[k] = prof_v[k];
   cfg.irregularity_scale = scale;
   cfg.track_seed = cfg.noise_seed = (uint64_t)seed;
   cfg.accel_rate_hz = 1.0 / dt_out;

@@ -25,6 +25,8 @@ struct hm_alarm_s {
   double displacement_limit_m; /* the displacement criterion's limit (0: off) */
   double hunted_at_kmh;   /* the lowest speed at which a criterion was met during the latch (INFINITY: none) */
   int precise;            /* the estimate was used alone at the last update with data (its hysteresis) */
+  double v_prev_kmh, t_prev_s, dvdt_kmh_s; /* the speed's trend: an exponential average of dv/dt over ~5 s */
+  int have_trend;
   /* the last table lookups (at the conicity in use and at the interval's optimistic end), reused while their
    * conicity and the speed are unchanged */
   struct {
@@ -173,6 +175,8 @@ void hm_alarm_reset(hm_alarm a) {
   a->latched = a->calm = 0;
   a->hunted_at_kmh = INFINITY;
   a->precise = 0;
+  a->have_trend = 0;
+  a->dvdt_kmh_s = 0.0;
   a->cache[0].valid = a->cache[1].valid = 0;
 }
 
@@ -354,7 +358,23 @@ hm_status hm_alarm_update(hm_alarm a, const hm_estimate *e, const hm_margin_esti
       s.hopf_low_kmh = a->hunted_at_kmh;
       s.hopf_low_from_hunting = 1;
     }
+    /* the speed's trend (accelerating toward a threshold makes a lower level short-lived) */
+    if (a->have_trend && now > a->t_prev_s) {
+      const double dt = now - a->t_prev_s, w = fmin(dt / HM_ALARM_TREND_S, 1.0);
+      a->dvdt_kmh_s += w * ((e->speed_kmh - a->v_prev_kmh) / dt - a->dvdt_kmh_s);
+    }
+    a->have_trend = 1;
+    a->v_prev_kmh = e->speed_kmh;
+    a->t_prev_s = now;
     target = raw_level(a, e, g, &s, a->level, &reason);
+    if (target < a->level && a->dvdt_kmh_s > 0.0) {
+      /* a lower level only if it would still hold at the speed the present acceleration reaches in
+       * HM_ALARM_LOWER_LOOKAHEAD_S: a train accelerating past a threshold just lowered would raise the level again */
+      hm_estimate ahead = *e;
+      ahead.speed_kmh += a->dvdt_kmh_s * HM_ALARM_LOWER_LOOKAHEAD_S;
+      hm_reason r_ahead;
+      if (raw_level(a, &ahead, g, &s, a->level, &r_ahead) >= a->level) target = a->level, reason = a->reason;
+    }
     if (target == HM_LEVEL_ALARM && oscillation_reason(reason)) {
       a->latched = 1;
       a->latch_reason = reason;

@@ -93,34 +93,60 @@ double hm_track_at(const hm_track t, double s) {
 
 double hm_track_rms_m(const hm_track t) { return t ? t->rms_m : 0.0; }
 
+hm_status hm_excited_model_init_profile(hm_excited_model *em, const hm_vehicle *veh, const hm_track track,
+                                        const double *t_s, const double *v_kmh, size_t n) {
+  if (!em || !veh || !t_s || !v_kmh) return HM_EINVAL;
+  if (n < 1 || n > HM_SPEED_PROFILE_MAX) return HM_EDOMAIN;
+  for (size_t k = 0; k < n; ++k)
+    if (!(v_kmh[k] > 0.0) || !isfinite(v_kmh[k]) || !isfinite(t_s[k]) || (k == 0 ? t_s[0] != 0.0 : !(t_s[k] > t_s[k - 1])))
+      return HM_EDOMAIN;
+  hm_excited_model out;
+  hm_status st = hm_model_init(&out.model, veh, hm_mps_from_kmh(v_kmh[0]));
+  if (st != HM_OK) return st;
+  out.track = track;
+  out.n_profile = n;
+  for (size_t k = 0; k < n; ++k) {
+    out.profile_t_s[k] = t_s[k];
+    out.profile_v_kmh[k] = v_kmh[k];
+    out.profile_s_m[k] = k == 0 ? 0.0
+                                : out.profile_s_m[k - 1] + 0.5 * hm_mps_from_kmh(v_kmh[k - 1] + v_kmh[k]) *
+                                                               (t_s[k] - t_s[k - 1]);
+  }
+  *em = out;
+  return HM_OK;
+}
+
 hm_status hm_excited_model_init(hm_excited_model *em, const hm_vehicle *veh, const hm_track track,
                                 double v_start_kmh, double v_end_kmh, double ramp_s) {
   if (!em || !veh) return HM_EINVAL;
   if (!(v_start_kmh > 0.0) || !(v_end_kmh > 0.0) || !isfinite(v_start_kmh) || !isfinite(v_end_kmh) ||
       !(ramp_s >= 0.0) || !isfinite(ramp_s))
     return HM_EDOMAIN;
-  hm_excited_model out;
-  hm_status st = hm_model_init(&out.model, veh, hm_mps_from_kmh(v_start_kmh));
-  if (st != HM_OK) return st;
-  out.track = track;
-  out.v_start_kmh = v_start_kmh;
-  out.v_end_kmh = v_end_kmh;
-  out.ramp_s = ramp_s;
-  *em = out;
-  return HM_OK;
+  const double t[2] = {0.0, ramp_s}, v[2] = {v_start_kmh, v_end_kmh};
+  if (ramp_s == 0.0) return hm_excited_model_init_profile(em, veh, track, t, v + 1, 1);
+  return hm_excited_model_init_profile(em, veh, track, t, v, 2);
+}
+
+/* The profile's segment holding t (k with t_k <= t < t_k+1), or n - 1 past its end. */
+static size_t profile_segment(const hm_excited_model *em, double t) {
+  size_t k = 0;
+  while (k + 1 < em->n_profile && em->profile_t_s[k + 1] <= t) ++k;
+  return k;
 }
 
 double hm_excited_speed_kmh(const hm_excited_model *em, double t) {
-  if (t >= em->ramp_s || em->ramp_s == 0.0) return em->v_end_kmh;
-  if (t <= 0.0) return em->v_start_kmh;
-  return em->v_start_kmh + (em->v_end_kmh - em->v_start_kmh) * t / em->ramp_s;
+  if (t <= 0.0) return em->profile_v_kmh[0];
+  const size_t k = profile_segment(em, t);
+  if (k + 1 >= em->n_profile) return em->profile_v_kmh[em->n_profile - 1];
+  const double f = (t - em->profile_t_s[k]) / (em->profile_t_s[k + 1] - em->profile_t_s[k]);
+  return em->profile_v_kmh[k] + (em->profile_v_kmh[k + 1] - em->profile_v_kmh[k]) * f;
 }
 
 double hm_excited_distance_m(const hm_excited_model *em, double t) {
-  const double v0 = hm_mps_from_kmh(em->v_start_kmh), v1 = hm_mps_from_kmh(em->v_end_kmh);
-  if (em->ramp_s == 0.0) return v1 * t;
-  const double tr = fmin(fmax(t, 0.0), em->ramp_s);
-  return v0 * tr + 0.5 * (v1 - v0) * tr * tr / em->ramp_s + v1 * fmax(t - em->ramp_s, 0.0);
+  if (t <= 0.0) return hm_mps_from_kmh(em->profile_v_kmh[0]) * t;
+  const size_t k = profile_segment(em, t);
+  const double dt = t - em->profile_t_s[k];
+  return em->profile_s_m[k] + 0.5 * hm_mps_from_kmh(em->profile_v_kmh[k] + hm_excited_speed_kmh(em, t)) * dt;
 }
 
 hm_status hm_excited_rhs(double t, const double *x, double *dxdt, void *params) {

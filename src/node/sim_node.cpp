@@ -6,6 +6,7 @@
 #include <std_msgs/Float64.h>
 
 #include <cmath>
+#include <vector>
 
 #include "yaml_params.h"
 
@@ -72,6 +73,24 @@ int main(int argc, char** argv) {
     ROS_FATAL("hunting_sim: need hold_s >= 0, accel_rate_hz in 100..5000, seed >= 0 and a finite kick_m");
     return 1;
   }
+  // a speed profile (steps and ramps) instead of the single ramp: ~profile_t_s and ~profile_v_kmh, equal lengths
+  std::vector<double> pt, pv;
+  pnh.getParam("profile_t_s", pt);
+  pnh.getParam("profile_v_kmh", pv);
+  if (pt.size() != pv.size() || pt.size() > HM_SPEED_PROFILE_MAX) {
+    ROS_FATAL("hunting_sim: ~profile_t_s and ~profile_v_kmh need the same length, at most %d (got %zu and %zu)",
+              HM_SPEED_PROFILE_MAX, pt.size(), pv.size());
+    return 1;
+  }
+  cfg.n_profile = pt.size();
+  for (size_t k = 0; k < pt.size(); ++k) cfg.profile_t_s[k] = pt[k], cfg.profile_v_kmh[k] = pv[k];
+  // the simulated wheels' conicity lambda(0) (the monitor keeps its own configuration): 0 keeps the vehicle's
+  double conicity = 0.0;
+  pnh.param("conicity_at_zero", conicity, 0.0);
+  if (conicity != 0.0 && hm_vehicle_set_conicity_at_zero(&veh, conicity) != HM_OK) {
+    ROS_FATAL("hunting_sim: ~conicity_at_zero %g: must be >= 0 and >= the Gaussian terms' value at y = 0", conicity);
+    return 1;
+  }
   cfg.track_seed = cfg.noise_seed = static_cast<uint64_t>(seed);
   hm_sensor_sim sim = nullptr;
   char why[160] = "";
@@ -84,7 +103,7 @@ int main(int argc, char** argv) {
   ros::Duration(1.0).sleep();  // let subscribers connect
   pub.t0 = ros::Time::now();
   const hm_sensor_sink sink = {publishAccel, publishSpeed, &pub};
-  const double duration = cfg.ramp_s + hold_s;
+  const double duration = (cfg.n_profile ? cfg.profile_t_s[cfg.n_profile - 1] : cfg.ramp_s) + hold_s;
   ros::Rate loop(100.0);
   while (ros::ok() && hm_sensor_sim_time(sim) < duration) {
     const double t = hm_sensor_sim_time(sim);

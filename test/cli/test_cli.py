@@ -630,6 +630,25 @@ def test_delta_r_from_profiles_and_the_chain():
             assert p.returncode != 0 and message in p.stderr and p.stdout == "", (args, p.stderr, p.stdout)
 
 
+def test_simulate_speed_profile():
+    # --profile T:V,...: the speed stream follows it exactly (linear between the points, steady after the last); bad
+    # profiles refused with one line
+    with tempfile.TemporaryDirectory() as d:
+        spd = os.path.join(d, "s.csv")
+        run("simulate", "--profile", "0:400,4:400,5:450,8:450", "--t", "10", "--irregularity", "0.01",
+            "--speed-out", spd, "--out", os.devnull)
+        with open(spd) as f:
+            rows = [tuple(map(float, line.split(","))) for line in list(f)[1:]]
+        assert len(rows) >= 99, len(rows)
+        for t, v in rows:
+            ref = 400.0 if t <= 4.0 else 450.0 if t >= 5.0 else 400.0 + 50.0 * (t - 4.0)
+            close(v, ref, 1e-9, f"profile speed at {t} s")
+        for bad, message in (("0:400,4", "--profile must be T:V"), ("1:400,4:450", "times increasing from 0 s"),
+                             ("0:400,4:-1", "speeds > 0 km/h")):
+            p = run("simulate", "--profile", bad, "--t", "1", "--out", os.devnull, ok=False)
+            assert p.returncode != 0 and message in p.stderr and p.stderr.count("\n") == 1, (bad, p.stderr)
+
+
 def test_json_numbers_round_trip():
     # numbers are written in their shortest form that reads back as the same double: a configured 8.96 MN/m comes
     # out as 8.96, a whole speed without an exponent, and a computed critical speed with every digit it needs (the

@@ -109,7 +109,8 @@ static void stale_input_is_no_data(void) {
 }
 
 /* Hysteresis and hold: from ALARM (above Hopf) down to 3 km/h below it the level stays ALARM; further down it
- * falls to WARN only after 3 s; a speed dithering around the WARN threshold changes the level once. */
+ * falls to WARN only after 3 s; a speed dithering around the WARN threshold changes the level once; a lower level is
+ * not taken while the speed accelerates back toward the threshold. */
 static void hysteresis_and_hold_prevent_chatter(void) {
   const double hopf = hopf_closed_form(0.1358);
   hm_alarm a = make();
@@ -139,6 +140,43 @@ static void hysteresis_and_hold_prevent_chatter(void) {
   }
   HM_CHECK(changes == 0, "%d level changes while dithering inside the hysteresis", changes);
   hm_alarm_destroy(a);
+  /* on a ramp: WARN at a speed 1 km/h above the WARN threshold; then the known conicity changes (the settings, as a
+   * new identification would) so that WARN starts about 15 km/h higher. Steady at that speed (beyond the hysteresis)
+   * the level falls to WATCH after the 3 s hold; accelerating at 1 km/h/s it stays WARN (the speed 30 s ahead would
+   * call for WARN again): no level change at all, where it would otherwise have gone down and come back seconds later */
+  for (int ramp = 0; ramp < 2; ++ramp) {
+    a = make();
+    e = estimate(400.0, 0.0);
+    hm_alarm_update(a, &e, NULL, -10.0, &s);
+    const double w0 = s.warn_from_kmh;
+    HM_CHECK_DELTA(w0, s.hopf_low_kmh - 10.0, 1e-9, "WARN from the lower end - 10 km/h (a range)");
+    hm_alarm_config c;
+    hm_alarm_config_default(&c);
+    c.conicity_fallback = 0.1290;
+    c.conicity_prior_low = 0.1290 - 1e-5;
+    c.conicity_prior_high = 0.1290 + 1e-5;
+    int n_changes = 0;
+    double w1 = 0.0;
+    for (int k = 0; k <= 200; ++k) { /* 20 s */
+      const double t = 0.1 * k;
+      if (k == 50) {
+        char why[160] = "";
+        HM_CHECK(hm_alarm_set_config(a, &c, &vehicle, why, sizeof why) == HM_OK, "%s", why);
+      }
+      e = estimate(w0 + 1.0 + (ramp && t > 5.0 ? t - 5.0 : 0.0), 0.0);
+      hm_alarm_update(a, &e, NULL, t, &s);
+      if (k == 51) w1 = s.warn_from_kmh;
+      n_changes += k > 0 && s.changed;
+    }
+    HM_CHECK(w1 > w0 + 12.0 && w1 < w0 + 17.0, "the new threshold %.1f, %.1f above", w1, w1 - w0);
+    if (ramp)
+      HM_CHECK(s.level == HM_LEVEL_WARN && n_changes == 0, "accelerating: %s after %d changes", hm_level_name(s.level),
+               n_changes);
+    else
+      HM_CHECK(s.level == HM_LEVEL_WATCH && n_changes == 1, "steady: %s after %d changes", hm_level_name(s.level),
+               n_changes);
+    hm_alarm_destroy(a);
+  }
 }
 
 /* Latching by cause (issue #21): an ALARM from the oscillation holds while the oscillation comes and goes, and is
