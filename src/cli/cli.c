@@ -388,6 +388,33 @@ int cli_read_csv(const char *path, int ncols, char header[][64], double **data, 
   return 0;
 }
 
+int cli_read_mm_columns(const char *command, const char *path, const char *first, const char *second, double **m_data,
+                        size_t *n) {
+  char header[2][64];
+  double *d = NULL;
+  size_t rows = 0;
+  if (cli_read_csv(path, 2, header, &d, &rows, 0)) return 1;
+  if (strcmp(header[0], first) != 0 || strcmp(header[1], second) != 0) {
+    fprintf(stderr, "hunting %s: %s: the header must be '%s,%s' (got '%s,%s')\n", command, path, first, second,
+            header[0], header[1]);
+    free(d);
+    return 1;
+  }
+  double *m = malloc((2 * rows + 1) * sizeof *m);
+  if (!m) {
+    free(d);
+    return cli_fail_status(command, HM_ENOMEM);
+  }
+  for (size_t i = 0; i < rows; ++i) {
+    m[i] = 1e-3 * d[2 * i];
+    m[rows + i] = 1e-3 * d[2 * i + 1];
+  }
+  free(d);
+  *m_data = m;
+  *n = rows;
+  return 0;
+}
+
 void jw_numbers(json_writer *w, const char *key, const double *x, size_t n) {
   jw_array(w, key);
   for (size_t i = 0; i < n; ++i) jw_number(w, NULL, x[i]);

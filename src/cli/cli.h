@@ -80,6 +80,12 @@ void jw_finish(json_writer *w);
  */
 int cli_read_csv(const char *path, int ncols, char header[][64], double **data, size_t *n, int allow_nonfinite);
 
+/* Two columns in millimetres with the header "first,second" (e.g. y_mm,delta_r_mm) into *m_data (malloc'd, 2 n + 1
+ * doubles, in metres: the first column, then the second from m_data + n) and *n. Prints "hunting COMMAND: FILE: the
+ * header must be ..." (or cli_read_csv's message) and returns nonzero on any error. */
+int cli_read_mm_columns(const char *command, const char *path, const char *first, const char *second, double **m_data,
+                        size_t *n);
+
 /* The same format read a row at a time (constant memory, for recordings of any length). */
 typedef struct {
   FILE *f;

@@ -27,28 +27,12 @@ const cli_option delta_r_opts[] = {
     {"out", "FILE", "write y_mm,delta_r_mm for 'hunting equivalent-conicity --delta-r'"},
     {NULL, NULL, NULL}};
 
-/* A y_mm,z_mm profile in metres into *p (arrays malloc'd: free p->y_m, the z's follow in the same block). */
+/* A y_mm,z_mm profile in metres into *p (one malloc'd block: free p->y_m). */
 static int read_profile(const char *path, hm_profile *p) {
-  char header[2][64];
-  double *d = NULL;
+  double *m = NULL;
   size_t n = 0;
-  if (cli_read_csv(path, 2, header, &d, &n, 0)) return 1;
-  if (strcmp(header[0], "y_mm") != 0 || strcmp(header[1], "z_mm") != 0) {
-    fprintf(stderr, "hunting delta-r: %s: the header must be 'y_mm,z_mm' (got '%s,%s')\n", path, header[0], header[1]);
-    free(d);
-    return 1;
-  }
-  double *buf = malloc((2 * n + 1) * sizeof(double));
-  if (!buf) {
-    free(d);
-    return cli_fail_status("delta-r", HM_ENOMEM);
-  }
-  for (size_t i = 0; i < n; ++i) {
-    buf[i] = 1e-3 * d[2 * i];
-    buf[n + i] = 1e-3 * d[2 * i + 1];
-  }
-  free(d);
-  *p = (hm_profile){buf, buf + n, n};
+  if (cli_read_mm_columns("delta-r", path, "y_mm", "z_mm", &m, &n)) return 1;
+  *p = (hm_profile){m, m + n, n};
   return 0;
 }
 

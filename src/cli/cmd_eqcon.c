@@ -66,28 +66,17 @@ int cmd_equivalent_conicity(const cli_args *a) {
   size_t count;
   const char *amps = cli_value(a, "amplitudes");
   if (parse_amplitudes(amps ? amps : "1:7.5:0.1", &from, &step, &count)) return 1;
-  char header[2][64];
-  double *d = NULL;
+  double *y = NULL; /* and delta-r from y + n, in metres */
   size_t n = 0;
-  if (cli_read_csv(path, 2, header, &d, &n, 0)) return 1;
-  if (strcmp(header[0], "y_mm") != 0 || strcmp(header[1], "delta_r_mm") != 0) {
-    fprintf(stderr, "hunting equivalent-conicity: %s: the header must be 'y_mm,delta_r_mm' (got '%s,%s')\n", path,
-            header[0], header[1]);
-    free(d);
-    return 1;
-  }
-  double *y = malloc((n ? n : 1) * sizeof(double)), *dr = malloc((n ? n : 1) * sizeof(double));
+  if (cli_read_mm_columns("equivalent-conicity", path, "y_mm", "delta_r_mm", &y, &n)) return 1;
+  const double *dr = y + n;
   double *amp = malloc(count * sizeof(double)), *con = malloc(count * sizeof(double)),
          *wl = malloc(count * sizeof(double));
   hm_eqcon e = NULL;
   int rc = 1;
-  if (!y || !dr || !amp || !con || !wl) {
+  if (!amp || !con || !wl) {
     rc = cli_fail_status("equivalent-conicity", HM_ENOMEM);
     goto done;
-  }
-  for (size_t i = 0; i < n; ++i) {
-    y[i] = 1e-3 * d[2 * i];
-    dr[i] = 1e-3 * d[2 * i + 1];
   }
   const hm_status st = hm_eqcon_create(&cfg, y, dr, n, &e, why, sizeof why);
   if (st != HM_OK) {
@@ -139,6 +128,6 @@ int cmd_equivalent_conicity(const cli_args *a) {
   rc = 0;
 done:
   hm_eqcon_destroy(e);
-  free(d), free(y), free(dr), free(amp), free(con), free(wl);
+  free(y), free(amp), free(con), free(wl);
   return rc;
 }
