@@ -74,6 +74,8 @@ void hm_clock_reset(hm_clock *c);
 /* One sample stamped stamp_s (sensor clock) received at receipt_s (receiver clock). HM_EINVAL for NULL or a
  * non-finite time (c untouched). */
 hm_status hm_clock_observe(hm_clock *c, double stamp_s, double receipt_s, hm_clock_verdict *verdict);
+/* The offset in use, receiver time - sensor time [s]; 0 before the first sample (or NULL). */
+double hm_clock_offset_s(const hm_clock *c);
 /* A receiver time on the sensor's time line: receiver_s - offset_s (receiver_s itself before the first sample),
  * never earlier than the previous result (the offset moves up by the least latency's changes). */
 double hm_clock_to_sensor(hm_clock *c, double receiver_s);

@@ -58,8 +58,11 @@ typedef struct {
  * >= 0). track is borrowed. */
 hm_status hm_excited_model_init(hm_excited_model *em, const hm_vehicle *veh, const hm_track track,
                                 double v_start_kmh, double v_end_kmh, double ramp_s);
-/* The same with a profile of n points (1..HM_SPEED_PROFILE_MAX; times increasing from 0, speeds > 0): steps are two
- * points close in time, holds two points at one speed. HM_EDOMAIN for an invalid one. */
+/* 1 for a valid speed profile: n points (1..HM_SPEED_PROFILE_MAX), finite times increasing from 0 s, finite speeds
+ * > 0 km/h; else 0. */
+int hm_speed_profile_valid(const double *t_s, const double *v_kmh, size_t n);
+/* The same with a profile of n points (hm_speed_profile_valid): steps are two points close in time, holds two points
+ * at one speed. HM_EDOMAIN for an invalid one. */
 hm_status hm_excited_model_init_profile(hm_excited_model *em, const hm_vehicle *veh, const hm_track track,
                                         const double *t_s, const double *v_kmh, size_t n);
 double hm_excited_speed_kmh(const hm_excited_model *em, double t_s);

@@ -114,6 +114,8 @@ hm_status hm_clock_observe(hm_clock *c, double stamp_s, double receipt_s, hm_clo
   return HM_OK;
 }
 
+double hm_clock_offset_s(const hm_clock *c) { return c && c->have_offset ? c->offset_s : 0.0; }
+
 double hm_clock_to_sensor(hm_clock *c, double receiver_s) {
   if (!c) return receiver_s;
   double t = c->have_offset ? receiver_s - c->offset_s : receiver_s;

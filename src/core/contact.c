@@ -188,6 +188,12 @@ static void contact(const rail *r, const wheel *w, double *height, double *u_bes
 /* The roll the wheelset takes when both wheels rest on their rails is within -+ this [rad]. */
 #define MAX_ROLL_RAD 0.02
 
+/* Both wheels of the wheelset rolled by phi. */
+static void roll_to(wheel *l, wheel *r, double phi) {
+  l->c = r->c = cos(phi);
+  l->sn = r->sn = sin(phi);
+}
+
 hm_status hm_contact_delta_r(const hm_contact_config *cfg, const hm_profile *wl, const hm_profile *wr,
                              const hm_profile *rl, const hm_profile *rr, const double *shifts, size_t n_shifts,
                              hm_contact_point *out, char *why, size_t len) {
@@ -208,20 +214,20 @@ hm_status hm_contact_delta_r(const hm_contact_config *cfg, const hm_profile *wl,
   wheel R = {wr, -1.0, cfg->r0_right_m, 0.5 * cfg->flange_back_distance_m, 0.5 * cfg->gauge_m, 0.0, 1.0, 0.0};
   /* every shift first (with roll: at both ends of the roll's range, and a root between): a wheel off its rail
    * anywhere is refused before anything is written */
+  const int n_ends = cfg->include_roll ? 2 : 1;
+  const double ends[2] = {cfg->include_roll ? -MAX_ROLL_RAD : 0.0, MAX_ROLL_RAD};
   for (size_t i = 0; i < n_shifts; ++i) {
     double lo, hi, hl, hr, u, y;
     int bad = !isfinite(shifts[i]);
     L.s = R.s = shifts[i];
-    for (int e = cfg->include_roll ? -1 : 0; !bad && e <= (cfg->include_roll ? 1 : 0); e += 2) {
-      L.c = R.c = cos(e * MAX_ROLL_RAD);
-      L.sn = R.sn = sin(e * MAX_ROLL_RAD);
+    for (int e = 0; !bad && e < n_ends; ++e) {
+      roll_to(&L, &R, ends[e]);
       bad = overlap(&left, &L, &lo, &hi) != 0 || overlap(&right, &R, &lo, &hi) != 0;
       if (!bad && cfg->include_roll) {
         contact(&left, &L, &hl, &u, &y);
         contact(&right, &R, &hr, &u, &y);
-        bad = e < 0 ? !(hl >= hr) : !(hl <= hr); /* the left side's need falls as it rolls up */
+        bad = e == 0 ? !(hl >= hr) : !(hl <= hr); /* the left side's need falls as it rolls up */
       }
-      if (!cfg->include_roll) break;
     }
     if (bad) {
       if (why && len)
@@ -242,8 +248,7 @@ hm_status hm_contact_delta_r(const hm_contact_config *cfg, const hm_profile *wl,
       double a = -MAX_ROLL_RAD, b = MAX_ROLL_RAD;
       for (int it = 0; it < 80 && b - a > 1e-13; ++it) {
         phi = 0.5 * (a + b);
-        L.c = R.c = cos(phi);
-        L.sn = R.sn = sin(phi);
+        roll_to(&L, &R, phi);
         contact(&left, &L, &hl, &ul, &p.wheel_y_left_m);
         contact(&right, &R, &hr, &ur, &p.wheel_y_right_m);
         if (hl > hr) a = phi;
@@ -251,8 +256,7 @@ hm_status hm_contact_delta_r(const hm_contact_config *cfg, const hm_profile *wl,
       }
       phi = 0.5 * (a + b);
     }
-    L.c = R.c = cos(phi);
-    L.sn = R.sn = sin(phi);
+    roll_to(&L, &R, phi);
     contact(&left, &L, &hl, &ul, &p.wheel_y_left_m);
     contact(&right, &R, &hr, &ur, &p.wheel_y_right_m);
     p.roll_rad = phi;

@@ -111,7 +111,6 @@ hm_status hm_eqcon_create(const hm_eqcon_config *cfg, const double *y, const dou
     t->cum[k] = k ? t->cum[k - 1] + 0.5 * (dr[k - 1] + dr[k]) * (y[k] - y[k - 1]) : 0.0;
   }
   equilibrium(y, dr, n, &t->y_eq);
-  t->i_eq = 0.0;
   t->i_eq = cumulative(t, t->y_eq);
   *out = t;
   return HM_OK;
@@ -217,7 +216,7 @@ static hm_status quad(const table *t, const void *p, integrand f, double a, doub
 
 /* The half of the integral from y_eq to a turning point: y = yt - (yt - y_eq) s^2, dy = 2 (yt - y_eq) s ds. */
 typedef struct {
-  double yt, J;
+  double yt;
 } half;
 
 static double half_integrand(const table *t, const void *p, double s) {
@@ -303,7 +302,7 @@ hm_status hm_eqcon_at(const hm_eqcon t, hm_eqcon_method method, double amplitude
   }
   const double J = 0.5 * (ja + jb);
   if (turning_point(t, 1, J, tol, &yhi) != 0 || turning_point(t, -1, J, tol, &ylo) != 0) return HM_EDOMAIN;
-  const half right = {yhi, J}, left = {ylo, J};
+  const half right = {yhi}, left = {ylo};
   double ir, il;
   hm_status st = quad(t, &right, half_integrand, 0.0, 1.0, tol, &ir);
   if (st != HM_OK) return st;

@@ -93,13 +93,18 @@ double hm_track_at(const hm_track t, double s) {
 
 double hm_track_rms_m(const hm_track t) { return t ? t->rms_m : 0.0; }
 
+int hm_speed_profile_valid(const double *t_s, const double *v_kmh, size_t n) {
+  if (!t_s || !v_kmh || n < 1 || n > HM_SPEED_PROFILE_MAX) return 0;
+  for (size_t k = 0; k < n; ++k)
+    if (!(v_kmh[k] > 0.0) || !isfinite(v_kmh[k]) || !isfinite(t_s[k]) || (k == 0 ? t_s[0] != 0.0 : !(t_s[k] > t_s[k - 1])))
+      return 0;
+  return 1;
+}
+
 hm_status hm_excited_model_init_profile(hm_excited_model *em, const hm_vehicle *veh, const hm_track track,
                                         const double *t_s, const double *v_kmh, size_t n) {
   if (!em || !veh || !t_s || !v_kmh) return HM_EINVAL;
-  if (n < 1 || n > HM_SPEED_PROFILE_MAX) return HM_EDOMAIN;
-  for (size_t k = 0; k < n; ++k)
-    if (!(v_kmh[k] > 0.0) || !isfinite(v_kmh[k]) || !isfinite(t_s[k]) || (k == 0 ? t_s[0] != 0.0 : !(t_s[k] > t_s[k - 1])))
-      return HM_EDOMAIN;
+  if (!hm_speed_profile_valid(t_s, v_kmh, n)) return HM_EDOMAIN;
   hm_excited_model out;
   hm_status st = hm_model_init(&out.model, veh, hm_mps_from_kmh(v_kmh[0]));
   if (st != HM_OK) return st;

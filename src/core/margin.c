@@ -8,9 +8,6 @@
 
 #include "hunting_monitor/linear.h"
 
-/* The Hopf speed reported when the linear model is stable at every speed at a conicity. */
-static const double NO_HOPF_KMH = HM_LINEAR_NO_HOPF_KMH;
-
 typedef struct {
   double t_end_s, speed_kmh;
   double sigma, sigma_stat;     /* decay rate and its statistical error [1/s] */
@@ -117,7 +114,7 @@ void hm_margin_reset(hm_margin m) {
 }
 
 double hm_margin_hopf_kmh(const hm_margin m, double conicity) {
-  return m ? hm_linear_hopf_kmh(&m->veh, conicity) : NO_HOPF_KMH;
+  return m ? hm_linear_hopf_kmh(&m->veh, conicity) : HM_LINEAR_NO_HOPF_KMH;
 }
 
 /* A window's checks and inversion into *w; the verdict says whether it can be used. */
@@ -365,7 +362,7 @@ static void model_free(const hm_margin m, const window *const *ws, size_t n, hm_
   r->hopf_free_valid = 1;
   r->hopf_free_kmh = vh;
   r->hopf_free_low_kmh = 1000.0 / x2;
-  r->hopf_free_high_kmh = x1 > 1000.0 / NO_HOPF_KMH ? 1000.0 / x1 : NO_HOPF_KMH;
+  r->hopf_free_high_kmh = x1 > 1000.0 / HM_LINEAR_NO_HOPF_KMH ? 1000.0 / x1 : HM_LINEAR_NO_HOPF_KMH;
 }
 
 void hm_margin_read(const hm_margin m, double now, hm_margin_estimate *out) {

@@ -63,13 +63,9 @@ hm_status hm_sensor_sim_create(const hm_vehicle *veh, const hm_sensor_sim_config
   if (!(c->v_start_kmh > 0.0) || !(c->v_end_kmh > 0.0) || !isfinite(c->v_start_kmh) || !isfinite(c->v_end_kmh))
     return refuse(why, why_len, HM_EDOMAIN, "speeds must be finite and > 0 km/h");
   if (!(c->ramp_s >= 0.0) || !isfinite(c->ramp_s)) return refuse(why, why_len, HM_EDOMAIN, "ramp_s must be >= 0");
-  if (c->n_profile > HM_SPEED_PROFILE_MAX)
-    return refuse(why, why_len, HM_EDOMAIN, "the speed profile has more than 16 points");
-  for (size_t k = 0; k < c->n_profile; ++k)
-    if (!(c->profile_v_kmh[k] > 0.0) || !isfinite(c->profile_v_kmh[k]) || !isfinite(c->profile_t_s[k]) ||
-        (k == 0 ? c->profile_t_s[0] != 0.0 : !(c->profile_t_s[k] > c->profile_t_s[k - 1])))
-      return refuse(why, why_len, HM_EDOMAIN,
-                    "the speed profile needs speeds > 0 km/h at times increasing from 0 s");
+  if (c->n_profile && !hm_speed_profile_valid(c->profile_t_s, c->profile_v_kmh, c->n_profile))
+    return refuse(why, why_len, HM_EDOMAIN,
+                  "the speed profile needs at most 16 points, speeds > 0 km/h at times increasing from 0 s");
   if (!(c->irregularity_scale >= 0.0) || !isfinite(c->irregularity_scale))
     return refuse(why, why_len, HM_EDOMAIN, "irregularity scale must be >= 0");
   if (!(c->wavelength_min_m >= 0.2) || !(c->wavelength_max_m > c->wavelength_min_m) || !(c->wavelength_max_m <= 1000.0))

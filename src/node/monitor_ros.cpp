@@ -283,7 +283,7 @@ void MonitorRos::onTimer(const ros::TimerEvent&) {
   m.header.stamp = now;
   m.header.frame_id = frame_id_;
   if (e.n_samples > 0) m.accel_stamp = ros::Time(rosTime(e.time_s));
-  m.sensor_clock_offset_s = clock_.have_offset ? clock_.offset_s : 0.0;
+  m.sensor_clock_offset_s = hm_clock_offset_s(&clock_);
   m.sensor_clock_steps = static_cast<uint32_t>(clock_.n_steps);
   m.level = static_cast<uint8_t>(s.level);
   m.reason_code = static_cast<uint8_t>(s.reason);
@@ -501,7 +501,7 @@ void MonitorRos::diagnoseInputs(diagnostic_updater::DiagnosticStatusWrapper& sta
   stat.add("rejected speeds", e.n_speed_rejected);
   stat.add("time jumps", time_jumps_);
   stat.add("last time jump", last_jump_.empty() ? std::string("none") : last_jump_);
-  stat.add("sensor clock offset (ROS time - stamp, least) [s]", clock_.have_offset ? clock_.offset_s : 0.0);
+  stat.add("sensor clock offset (ROS time - stamp, least) [s]", hm_clock_offset_s(&clock_));
   stat.add("latest sample's latency beyond the least [s]", clock_.latency_s);
   stat.add("sensor clock steps", clock_.n_steps);
   stat.add("samples dropped: stamped ahead of ROS time", clock_.n_dropped);

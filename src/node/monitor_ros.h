@@ -52,7 +52,7 @@ class MonitorRos {
   // least once a second).
   void publishLevel(hm_level level, hm_reason reason, const std::string& text, bool latched, const ros::Time& now);
   // ROS time of a time on the sensor's line.
-  double rosTime(double line_s) const { return line_s + (clock_.have_offset ? clock_.offset_s : 0.0); }
+  double rosTime(double line_s) const { return line_s + hm_clock_offset_s(&clock_); }
   // An update that failed still gives a status (NO_DATA, the reason in words) and the alarm level NO_DATA.
   void publishFailure(hm_status st, const ros::Time& now);
   void diagnoseInputs(diagnostic_updater::DiagnosticStatusWrapper& stat);

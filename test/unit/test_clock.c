@@ -186,11 +186,12 @@ static void steps_of_the_clock(void) {
 static void bad_input(void) {
   hm_clock c = make();
   hm_clock_verdict v = HM_CLOCK_DROP;
-  HM_CHECK(hm_clock_to_sensor(&c, 5.0) == 5.0, "no offset yet");
+  HM_CHECK(hm_clock_to_sensor(&c, 5.0) == 5.0 && hm_clock_offset_s(&c) == 0.0, "no offset yet");
   HM_CHECK(hm_clock_observe(&c, NAN, 1.0, &v) == HM_EINVAL && hm_clock_observe(&c, 1.0, INFINITY, &v) == HM_EINVAL &&
                hm_clock_observe(NULL, 1.0, 1.0, &v) == HM_EINVAL && !c.have_offset && v == HM_CLOCK_DROP,
            "non-finite refused");
   HM_CHECK(hm_clock_observe(&c, 100.0, 100.25, &v) == HM_OK && v == HM_CLOCK_USE, "first");
+  HM_CHECK_DELTA(hm_clock_offset_s(&c), 0.25, 1e-12, "offset: receipt - stamp");
   HM_CHECK_DELTA(hm_clock_to_sensor(&c, 101.0), 100.75, 1e-12, "mapped");
   HM_CHECK_DELTA(hm_clock_to_sensor(&c, 100.9), 100.75, 1e-12, "never back");
   hm_clock_config cfg;
