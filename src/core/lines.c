@@ -3,6 +3,8 @@
 
 #include "hunting_monitor/model.h"
 
+#include "select.h"
+
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -14,9 +16,7 @@ enum { MAX_CANDIDATES = 32, MAX_DIVISOR = 12 };
 struct hm_lines_s {
   hm_lines_config cfg;
   size_t max_bins;
-  double *bg;      /* local background per bin */
-  double *window;  /* the running median's window, sorted */
-  size_t window_cap;
+  double *window;  /* scratch for a median's selection */
 };
 
 void hm_lines_config_default(hm_lines_config *c) {
@@ -54,10 +54,8 @@ hm_status hm_lines_create(const hm_lines_config *cfg, size_t max_bins, hm_lines 
   if (!l) return HM_ENOMEM;
   l->cfg = *cfg;
   l->max_bins = max_bins;
-  l->window_cap = max_bins;
-  l->bg = malloc(max_bins * sizeof(double));
   l->window = malloc(max_bins * sizeof(double));
-  if (!l->bg || !l->window) {
+  if (!l->window) {
     hm_lines_destroy(l);
     return HM_ENOMEM;
   }
@@ -67,7 +65,6 @@ hm_status hm_lines_create(const hm_lines_config *cfg, size_t max_bins, hm_lines 
 
 void hm_lines_destroy(hm_lines l) {
   if (!l) return;
-  free(l->bg);
   free(l->window);
   free(l);
 }
@@ -76,32 +73,6 @@ typedef struct {
   double f, ratio;
   size_t k;
 } candidate;
-
-/* The position of the first element of x[0..m) not below v (x sorted). */
-static size_t lower_bound(const double *x, size_t m, double v) {
-  size_t lo = 0, hi = m;
-  while (lo < hi) {
-    const size_t mid = lo + (hi - lo) / 2;
-    if (x[mid] < v) lo = mid + 1;
-    else hi = mid;
-  }
-  return lo;
-}
-
-static void sorted_insert(double *x, size_t *m, double v) {
-  const size_t i = lower_bound(x, *m, v);
-  memmove(x + i + 1, x + i, (*m - i) * sizeof(double));
-  x[i] = v;
-  ++*m;
-}
-
-/* Remove one element equal to v (it is there: the window holds it). */
-static void sorted_remove(double *x, size_t *m, double v) {
-  const size_t i = lower_bound(x, *m, v);
-  if (i >= *m) return;
-  memmove(x + i, x + i + 1, (*m - i - 1) * sizeof(double));
-  --*m;
-}
 
 hm_status hm_lines_find(hm_lines l, const double *p, size_t n, double df, double T, double f_lo, double f_hi,
                         unsigned char *exclude, hm_lines_result *out) {
@@ -116,26 +87,28 @@ hm_status hm_lines_find(hm_lines l, const double *p, size_t n, double df, double
     *out = r;
     return HM_OK;
   }
-  /* local backgrounds and the candidates (local maxima over +- a main lobe, at least two bins) */
+  /* the candidates: local maxima over +- a main lobe (at least two bins) at least candidate_ratio above their local
+   * background, the median of the bins within +-h */
   const size_t lobe = (size_t)fmax(2.0, round(0.5 / (T * df)));
-  /* the running median: the window's values kept sorted, one value out and one in per bin (O(h) a bin) */
-  size_t wa = k_lo > h ? k_lo - h : 1, wb = wa, nw = 0; /* the window is p[wa, wb) */
-  for (size_t k = k_lo; k <= k_hi; ++k) {
-    const size_t a = k > h ? k - h : 1, b = k + h < n ? k + h + 1 : n;
-    for (; wa < a; ++wa) sorted_remove(l->window, &nw, p[wa]);
-    for (; wb < b; ++wb) sorted_insert(l->window, &nw, p[wb]);
-    l->bg[k] = l->window[nw / 2] / log(2.0);
-  }
   candidate cand[MAX_CANDIDATES];
   size_t nc = 0;
   for (size_t k = k_lo; k <= k_hi; ++k) {
-    if (!(l->bg[k] > 0.0)) continue;
-    const double ratio = p[k] / l->bg[k];
-    if (ratio < c->candidate_ratio) continue;
     int is_max = 1;
     for (size_t j = k > lobe ? k - lobe : 0; j <= k + lobe && j < n && is_max; ++j)
       if (j != k && p[j] > p[k]) is_max = 0;
     if (!is_max) continue;
+    const size_t a = k > h ? k - h : 1, b = k + h < n ? k + h + 1 : n;
+    /* the median is at most p_k ln 2 / ratio exactly when more than half the window is: counted first (a pass
+     * without branches), the median selected for the few that pass */
+    const double thr = p[k] * log(2.0) / c->candidate_ratio * (1.0 + 1e-12);
+    size_t below = 0;
+    for (size_t j = a; j < b; ++j) below += p[j] <= thr;
+    if (below < (b - a) / 2 + 1) continue;
+    memcpy(l->window, p + a, (b - a) * sizeof(double));
+    const double bg = hm_select_kth(l->window, b - a, (b - a) / 2) / log(2.0);
+    if (!(bg > 0.0)) continue;
+    const double ratio = p[k] / bg;
+    if (ratio < c->candidate_ratio) continue;
     ++r.candidates;
     /* the parabola through the logarithms of the three bins at the peak */
     const double ym = log(fmax(p[k - 1], 1e-300)), y0 = log(p[k]), yp = log(fmax(p[k + 1], 1e-300));

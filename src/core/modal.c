@@ -20,6 +20,8 @@ struct hm_modal_s {
   hm_biquad hp, lp[2];
   double *ring;                /* decimated samples */
   size_t cap, n_win, head, n_in, since_fit;
+  size_t min_n;                /* decimated samples in min_window_s (as many as arrive in it: rounded down) */
+  double fit_every;            /* decimated samples between fits (fit_interval_s) */
   size_t nfft_max, nfft;
   double *re, *im, *cosw, *sinw; /* FFT work and twiddles (nfft_max / 2) */
   double *w, *pgram, *u;       /* band bins: angular frequency, periodogram, ln(w / w_ref) */
@@ -112,6 +114,8 @@ static void apply_rate(hm_modal m, double fs, unsigned r, double fd) {
   m->n_win = (size_t)ceil(m->cfg.window_s * fd);
   if (m->n_win > m->cap) m->n_win = m->cap;
   m->nfft = pow2_at_least((double)m->n_win);
+  m->min_n = (size_t)floor(m->cfg.min_window_s * fd + 1e-6);
+  m->fit_every = m->cfg.fit_interval_s * fd;
   hm_modal_reset(m);
 }
 
@@ -196,18 +200,15 @@ void hm_modal_push(hm_modal m, double a) {
   ++m->since_fit;
 }
 
-/* Decimated samples in min_window_s (as many as arrive in it: rounded down). */
-static size_t min_samples(const hm_modal m) { return (size_t)floor(m->cfg.min_window_s * m->fd + 1e-6); }
-
 int hm_modal_fit_due(const hm_modal m) {
-  return m && m->n_in >= min_samples(m) && (double)m->since_fit >= m->cfg.fit_interval_s * m->fd;
+  return m && m->n_in >= m->min_n && (double)m->since_fit >= m->fit_every;
 }
 
-/* S_k (its gradient of ln S_k in grad, if not NULL) for bin k. */
-static double spectrum(const double *th, double w, double u, double *grad) {
+/* S_k (its gradient of ln S_k in grad, if not NULL) for bin k; n = exp(th[P_LN]), the noise level (one exp per pass). */
+static double spectrum(const double *th, double n, double w, double u, double *grad) {
   const double sg = th[P_SIGMA], w0 = th[P_W0];
   const double re = sg * sg + w0 * w0 - w * w, d = re * re + 4.0 * sg * sg * w * w;
-  const double b = exp(th[P_C0] + u * (th[P_C1] + u * (th[P_C2] + u * th[P_C3]))), n = exp(th[P_LN]);
+  const double b = exp(th[P_C0] + u * (th[P_C1] + u * (th[P_C2] + u * th[P_C3])));
   const double mode = b / d, s = mode + n;
   if (grad) {
     const double dd_sg = 4.0 * re * sg + 8.0 * sg * w * w, dd_w0 = 4.0 * re * w0, ms = mode / s;
@@ -222,13 +223,28 @@ static double spectrum(const double *th, double w, double u, double *grad) {
   return s;
 }
 
-/* Negative Whittle log-likelihood over the band's nb bins. */
-static double objective(const hm_modal m, size_t nb, const double *th) {
+/* The negative Whittle log-likelihood over the band's nb bins at th and, when f is not NULL, the Fisher information
+ * J'J in f and the score J'(I/S - 1) in g there: one pass, one exp and one log a bin. */
+static double evaluate(const hm_modal m, size_t nb, const double *th, double f[NP][NP], double *g) {
   double l = 0.0;
-  for (size_t k = 0; k < nb; ++k) {
-    const double sk = spectrum(th, m->w[k], m->u[k], NULL);
-    l += log(sk) + m->pgram[k] / sk;
+  const double noise = exp(th[P_LN]);
+  if (f) {
+    memset(f, 0, sizeof(double) * NP * NP);
+    memset(g, 0, sizeof(double) * NP);
   }
+  for (size_t k = 0; k < nb; ++k) {
+    double j[NP];
+    const double sk = spectrum(th, noise, m->w[k], m->u[k], f ? j : NULL), q = m->pgram[k] / sk;
+    l += log(sk) + q;
+    if (!f) continue;
+    for (int a = 0; a < NP; ++a) {
+      g[a] += j[a] * (q - 1.0);
+      for (int b = 0; b <= a; ++b) f[a][b] += j[a] * j[b];
+    }
+  }
+  if (f)
+    for (int a = 0; a < NP; ++a)
+      for (int b = a + 1; b < NP; ++b) f[a][b] = f[b][a];
   return l;
 }
 
@@ -258,31 +274,17 @@ static int chol_solve(double a[NP][NP], double *b) {
   return 1;
 }
 
-/* Fisher information J'J and score J'(I/S - 1) at th. */
-static void scoring_system(const hm_modal m, size_t nb, const double *th, double f[NP][NP], double *g) {
-  memset(f, 0, sizeof(double) * NP * NP);
-  memset(g, 0, sizeof(double) * NP);
-  for (size_t k = 0; k < nb; ++k) {
-    double j[NP];
-    const double r = m->pgram[k] / spectrum(th, m->w[k], m->u[k], j) - 1.0;
-    for (int a = 0; a < NP; ++a) {
-      g[a] += j[a] * r;
-      for (int b = 0; b <= a; ++b) f[a][b] += j[a] * j[b];
-    }
-  }
-  for (int a = 0; a < NP; ++a)
-    for (int b = a + 1; b < NP; ++b) f[a][b] = f[b][a];
-}
-
-/* Levenberg-damped Fisher scoring from th (updated in place); the final objective in *obj, steps in *iters.
- * 1 if converged (relative objective change below tol on an accepted step), 0 otherwise. */
-static int score(const hm_modal m, size_t nb, double *th, double *obj, unsigned *iters) {
-  double l = objective(m, nb, th), mu = 1e-3;
-  for (unsigned it = 0; it < m->cfg.max_iter; ++it) {
-    double f[NP][NP], g[NP];
-    scoring_system(m, nb, th, f, g);
-    for (int tries = 0; tries < 30; ++tries) {
-      double a[NP][NP], step[NP], trial[NP];
+/* Levenberg-damped Fisher scoring from th (updated in place); the final objective in *obj, its Fisher information in
+ * fisher, steps in *iters. 1 if converged (relative objective change below tol on an accepted step), 0 otherwise.
+ * A step that raises the objective by less than tol (relative) ends it too: th is at the optimum to the tolerance. */
+static int score(const hm_modal m, size_t nb, double *th, double *obj, unsigned *iters, double fisher[NP][NP]) {
+  double f[NP][NP], g[NP];
+  double l = evaluate(m, nb, th, f, g), mu = 1e-3;
+  int converged = 0;
+  for (unsigned it = 0; it < m->cfg.max_iter && !converged; ++it) {
+    int accepted = 0;
+    for (int tries = 0; tries < 30 && !accepted && !converged; ++tries) {
+      double a[NP][NP], step[NP], trial[NP], ft[NP][NP], gt[NP];
       memcpy(a, f, sizeof a);
       memcpy(step, g, sizeof step);
       for (int i = 0; i < NP; ++i) a[i][i] += mu * f[i][i] + 1e-12;
@@ -292,27 +294,38 @@ static int score(const hm_modal m, size_t nb, double *th, double *obj, unsigned 
       }
       for (int i = 0; i < NP; ++i) trial[i] = th[i] + step[i];
       trial[P_LN] = fmax(trial[P_LN], -60.0); /* a floor far below any signal: the noise may be absent */
-      const double lt = objective(m, nb, trial);
+      /* the first try is usually taken: its scoring system comes in the same pass; after a refusal only the
+       * objective, and the scoring system once a try is taken */
+      const double lt = evaluate(m, nb, trial, tries == 0 ? ft : NULL, gt);
       if (isfinite(lt) && lt <= l) {
         const double change = (l - lt) / (fabs(l) + 1.0);
+        if (tries > 0) evaluate(m, nb, trial, ft, gt);
         memcpy(th, trial, sizeof trial);
+        memcpy(f, ft, sizeof f);
+        memcpy(g, gt, sizeof g);
         l = lt;
         mu = fmax(mu * 0.3, 1e-9);
         *iters = it + 1;
-        *obj = l;
-        if (change < m->cfg.tol) return 1;
-        break;
+        accepted = 1;
+        converged = change < m->cfg.tol;
+        continue;
+      }
+      if (isfinite(lt) && (lt - l) / (fabs(l) + 1.0) < m->cfg.tol) { /* at the optimum to the tolerance: a step
+                                                                         that changes nothing but rounding */
+        *iters = it + 1;
+        converged = 1;
+        continue;
       }
       mu *= 10.0;
       if (mu > 1e12) { /* no descent direction left: a stationary point */
         *iters = it + 1;
-        *obj = l;
-        return 1;
+        converged = 1;
       }
     }
   }
   *obj = l;
-  return 0;
+  memcpy(fisher, f, sizeof f);
+  return converged;
 }
 
 /* A cold start: the smoothed periodogram's peak, a given decay rate, a flat background, a low noise floor. */
@@ -343,7 +356,7 @@ hm_status hm_modal_fit(hm_modal m, double max_window_s, hm_mode_estimate *out) {
   memset(&r, 0, sizeof r);
   const size_t n = (size_t)fmin((double)m->n_in, floor(max_window_s * m->fd + 1e-6));
   r.window_s = (double)n / m->fd;
-  if (n < min_samples(m)) {
+  if (n < m->min_n) {
     *out = r;
     return HM_OK;
   }
@@ -352,11 +365,8 @@ hm_status hm_modal_fit(hm_modal m, double max_window_s, hm_mode_estimate *out) {
   double mean = 0.0;
   for (size_t k = 0; k < n; ++k) mean += m->ring[(oldest + k) % m->n_win];
   mean /= (double)n;
-  for (size_t k = 0; k < m->nfft; ++k) {
-    m->re[k] = k < n ? m->ring[(oldest + k) % m->n_win] - mean : 0.0;
-    m->im[k] = 0.0;
-  }
-  hm_fft(m->re, m->im, m->nfft, m->cosw, m->sinw, m->nfft_max);
+  for (size_t k = 0; k < m->nfft; ++k) m->re[k] = k < n ? m->ring[(oldest + k) % m->n_win] - mean : 0.0;
+  hm_fft_real(m->re, m->im, m->nfft, m->cosw, m->sinw, m->nfft_max);
   const double df = m->fd / (double)m->nfft, w_ref = 2.0 * HM_PI * 0.5 * (m->cfg.band_low_hz + m->cfg.band_high_hz);
   /* a comb of lines (a periodic excitation of the track) over the decimated signal's band */
   const size_t nbins = m->nfft / 2 + 1;
@@ -391,21 +401,22 @@ hm_status hm_modal_fit(hm_modal m, double max_window_s, hm_mode_estimate *out) {
   }
   for (size_t k = 0; k < nb; ++k) m->pgram[k] /= scale;
   /* warm start from the last fit, and cold starts at two decay rates; the best likelihood wins */
-  double best[NP], best_obj = INFINITY;
+  double best[NP], best_f[NP][NP], best_obj = INFINITY;
   int found = 0;
   unsigned iters = 0;
   for (int start = m->have_theta ? 0 : 1; start < 3; ++start) {
-    double th[NP], obj;
+    double th[NP], obj, fisher[NP][NP];
     unsigned it = 0;
     if (start == 0) {
       memcpy(th, m->theta, sizeof th);
     } else {
       cold_start(m, nb, start == 1 ? -0.7 : -4.0, th);
     }
-    const int ok = score(m, nb, th, &obj, &it);
+    const int ok = score(m, nb, th, &obj, &it, fisher);
     iters += it;
     if (ok && obj < best_obj) {
       memcpy(best, th, sizeof best);
+      memcpy(best_f, fisher, sizeof best_f);
       best_obj = obj;
       found = 1;
     }
@@ -418,12 +429,11 @@ hm_status hm_modal_fit(hm_modal m, double max_window_s, hm_mode_estimate *out) {
   memcpy(m->theta, best, sizeof best);
   m->have_theta = 1;
   /* standard errors from Whittle's covariance (J'J)^-1, for the n independent ordinates of nfft padded ones */
-  double f[NP][NP], g[NP], var[NP];
-  scoring_system(m, nb, best, f, g);
+  double var[NP];
   const double padding = (double)m->nfft / (double)n;
   for (int i = 0; i < NP; ++i) {
     double a[NP][NP], e[NP] = {0};
-    memcpy(a, f, sizeof a);
+    memcpy(a, best_f, sizeof a);
     e[i] = 1.0;
     var[i] = chol_solve(a, e) ? e[i] * padding : INFINITY;
   }
