@@ -29,8 +29,9 @@
  *   ALARM    hunting or its onset: a criterion met (sliding r.m.s., consecutive peaks, with the limits of the
  *            measurement point; the displacement amplitude at any frequency of the band, estimator.h), the speed above the Hopf interval (the origin is unstable), or the displacement
  *            amplitude at or beyond the edge. Reduce speed now, below the lower end of the Hopf interval.
- *   WARN     close to the boundary: the speed at or above warn_from_kmh, inside the Hopf interval or within
- *            warn_speed_margin_kmh below it (see below), or the amplitude above warn_amplitude_fraction of the edge.
+ *   WARN     close to the boundary: the speed at or above warn_from_kmh (warn_speed_margin_kmh below the Hopf speed,
+ *            or one standard error of it where larger: see below), or the amplitude above warn_amplitude_fraction of
+ *            the edge.
  *            Do not accelerate; reduce speed by the margin.
  *   WATCH    the speed at or above watch_from_kmh (the same with watch_speed_margin_kmh), or the vehicle not behaving like its
  *            model (the model-based and model-free Hopf speeds disagree), or the sensor at another rate than
@@ -40,12 +41,21 @@
  *            lowest cycle speed, docs/MODEL.md section 7) is stated in the status fields, not as a level: on good track
  *            at service speed it is permanent and a level that never changes tells a driver nothing.
  * The speed margins allow for the speed's own excursion and the driver's reaction. Below a range (the prior's Hopf
- * speeds, the table's error, the more cautious of an estimate and the prior) they are added to its lower end: from
- * hopf_low - margin. Below an identified interval, whose lower half-width h = point - hopf_low is interval_z standard
- * errors of the Hopf speed, an error independent of the margin's allowance, the two add in quadrature: from
- * point - sqrt(h^2 + margin^2) (h = 0: point - margin; margin 0: hopf_low). Added linearly they would count the
- * estimate's uncertainty twice over: with 50 s at each of 380 and 420 km/h (h = 15-20 km/h), a WARN 28-33 km/h
- * below the Hopf speed on a vehicle with conicity 0.16 (issue #18).
+ * speeds, the table's error) they are added to its lower end: from hopf_low - margin. Below an identified interval,
+ * whose lower half-width h = point - hopf_low is interval_z standard errors of the Hopf speed (the model-free lower
+ * end included where it counts), an error independent of the margin's allowance:
+ *   WATCH from point - sqrt(h^2 + watch_margin^2): the margin and the whole half-width in quadrature (the Hopf speed
+ *         may lie that low: have it checked);
+ *   WARN  from point - max(warn_margin, h / interval_z): the point less the margin, or less one standard error where
+ *         that is larger (the speed then within the Hopf speed's likely range: about one chance in six that it is
+ *         already at or above it).
+ * An estimate too uncertain to be used alone gives its own WARN threshold the same way, and the more cautious of it
+ * and the prior's range (its lower end less the margin) counts (with model_mismatch: the combined range's lower end
+ * less the margin). Why not the half-width for WARN too (in quadrature, as until this change, or linearly as before
+ * that): the windows of 50 s at each of 380 and 420 km/h give the Hopf speed to 6-16 km/h (one standard error, the
+ * windows' Birge ratio included), and a WARN from two standard errors below the point came 21-40 km/h below the true
+ * Hopf speed on 6 of 16 recordings of a vehicle with conicity 0.16 (issue #18: no WARN more than 20 km/h below it);
+ * from one standard error, on none of 20 (scripts/evaluate_line).
  * Thresholds of the current (or a higher) level are relaxed by the hysteresis (hysteresis_kmh on speeds,
  * hysteresis_amplitude_fraction of the edge on amplitudes), a higher level is taken at once, and a lower one only
  * after the conditions for it have held for min_hold_s, and only if they would still hold at the speed the present
@@ -111,7 +121,7 @@ const char *hm_reason_text(hm_reason reason); /* a short English sentence */
 
 typedef struct {
   double warn_amplitude_fraction;       /* WARN above this fraction of the edge amplitude */
-  double warn_speed_margin_kmh;         /* WARN within this below the Hopf interval (in quadrature below an identified one) */
+  double warn_speed_margin_kmh;         /* WARN within this below a range's lower end, or an identified point (below) */
   double watch_speed_margin_kmh;        /* WATCH within this below it (>= the WARN margin) */
   double hysteresis_kmh;
   double hysteresis_amplitude_fraction;

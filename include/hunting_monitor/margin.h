@@ -80,6 +80,7 @@ typedef struct {
   int conicity_valid;               /* (a) */
   double conicity, conicity_se;
   double conicity_low, conicity_high; /* conicity -+ interval_z standard errors (low: Hopf at hopf_model_high) */
+  double interval_z;                /* the intervals' half-width in standard errors (the configuration's) */
   int hopf_model_valid;
   double hopf_model_kmh, hopf_model_low_kmh, hopf_model_high_kmh;
   int hopf_free_valid;              /* (b) */

@@ -293,7 +293,8 @@ static hm_status assess(hm_alarm a, const hm_estimate *e, const hm_margin_estima
   }
   /* the model-free interval's lower end counts when the vehicle does not behave like its model, and whenever its
    * regression has residuals to check it (three windows or more); with a mismatch its upper end bounds too */
-  if (g && g->hopf_free_valid && (g->model_mismatch || g->n_windows >= HM_ALARM_FREE_MIN_WINDOWS)) {
+  const int free_counts = g && g->hopf_free_valid && (g->model_mismatch || g->n_windows >= HM_ALARM_FREE_MIN_WINDOWS);
+  if (free_counts) {
     lo = fmin(lo, g->hopf_free_low_kmh);
     if (g->model_mismatch && g->hopf_free_high_kmh < hi) hi = g->hopf_free_high_kmh;
   }
@@ -308,11 +309,19 @@ static hm_status assess(hm_alarm a, const hm_estimate *e, const hm_margin_estima
   s->hopf_low_kmh = fmin(lo, b.hopf_speed_kmh);
   s->hopf_high_kmh = fmax(hi, b.hopf_speed_kmh);
   s->boundaries = b;
-  /* the speed margins (alarm.h): in quadrature with an identified interval's statistical half-width, added to a
-   * range's lower end */
+  /* the speed margins (alarm.h): added to a range's lower end; below an identified interval WATCH in quadrature with
+   * its lower half-width h, WARN from the point less the larger of the margin and one standard error (h / z); an
+   * estimate too uncertain to be used alone (the vehicle behaving like its model) gives its own WARN threshold so,
+   * and the more cautious of it and the prior's range counts */
   const double h = precise ? b.hopf_speed_kmh - s->hopf_low_kmh : 0.0;
   const double from = precise ? b.hopf_speed_kmh : s->hopf_low_kmh;
-  s->warn_from_kmh = from - hypot(h, c->warn_speed_margin_kmh);
+  const double z = g && g->interval_z > 0.0 ? g->interval_z : 1.0;
+  s->warn_from_kmh = from - fmax(c->warn_speed_margin_kmh, h / z);
+  if (have && !precise && !g->model_mismatch) {
+    const double lo_e = free_counts ? fmin(g->hopf_model_low_kmh, g->hopf_free_low_kmh) : g->hopf_model_low_kmh;
+    const double from_e = g->hopf_model_kmh - fmax(c->warn_speed_margin_kmh, (g->hopf_model_kmh - lo_e) / z);
+    s->warn_from_kmh = fmin(a->prior_hopf_low_kmh - c->warn_speed_margin_kmh, from_e);
+  }
   s->watch_from_kmh = from - hypot(h, c->watch_speed_margin_kmh);
   /* the edge: at the conicity in use where the origin is stable there; inside the Hopf interval above the point
    * estimate, at the interval's optimistic end (found by the lookup at the conicity whose Hopf speed is hopf_high,

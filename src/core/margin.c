@@ -385,6 +385,7 @@ void hm_margin_read(const hm_margin m, double now, hm_margin_estimate *out) {
   r.n_windows = (unsigned)n;
   if (n == 0) r.speed_min_kmh = r.speed_max_kmh = 0.0;
   r.birge_ratio = 1.0;
+  r.interval_z = m->cfg.interval_z;
   model_based(m, ws, n, &r);
   model_free(m, ws, n, &r);
   for (size_t k = 0; k < m->misfit_n; ++k)

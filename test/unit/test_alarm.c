@@ -281,8 +281,8 @@ static void bad_configuration_and_input(void) {
 }
 
 /* With a conicity estimate (0.16 +- 0.003, as margin.h makes them): the Hopf interval is the closed form's at the
- * interval's conicities; the margins (10 and 30 km/h) combine with its lower half-width h in quadrature: WARN from
- * point - sqrt(h^2 + 10^2), WATCH from point - sqrt(h^2 + 30^2), 0.5 km/h either side; inside it above the point estimate a small oscillation is WARN, not ALARM; above it ALARM;
+ * interval's conicities; WARN from the point less the larger of the 10 km/h margin and one standard error (h / 2, the
+ * interval's lower half-width h in standard errors), WATCH from point - sqrt(h^2 + 30^2) (in quadrature), 0.5 km/h either side; inside it above the point estimate a small oscillation is WARN, not ALARM; above it ALARM;
  * a large standard error falls back to the vehicle's conicity; a mismatch or a sensor at another rate is WATCH; a
  * rate the filters cannot use is NO_DATA. */
 static void levels_with_a_conicity_estimate(void) {
@@ -293,11 +293,12 @@ static void levels_with_a_conicity_estimate(void) {
   g.conicity_se = 0.003;
   g.conicity_low = 0.154;
   g.conicity_high = 0.166;
+  g.interval_z = 2.0;
   g.hopf_model_kmh = hopf_closed_form(0.16);
   g.hopf_model_low_kmh = hopf_closed_form(0.166);
   g.hopf_model_high_kmh = hopf_closed_form(0.154);
   const double h = g.hopf_model_kmh - g.hopf_model_low_kmh;
-  const double warn_from = g.hopf_model_kmh - sqrt(h * h + 100.0), watch_from = g.hopf_model_kmh - sqrt(h * h + 900.0);
+  const double warn_from = g.hopf_model_kmh - fmax(10.0, h / 2.0), watch_from = g.hopf_model_kmh - sqrt(h * h + 900.0);
   const struct {
     double v, amp;
     hm_level level;
@@ -327,7 +328,8 @@ static void levels_with_a_conicity_estimate(void) {
   }
   /* too uncertain to be used alone (0.16 +- 0.05): not replaced by the narrower prior (0.1358 in 0.1058..0.1658) but
    * combined with it, the more cautious of each: the estimate's point (its Hopf speed is the lower), its low end
-   * (Hopf at 0.26), the prior's high end (Hopf at 0.1058); at 400 km/h that is WARN */
+   * (Hopf at 0.26), the prior's high end (Hopf at 0.1058); WARN from the more cautious of the prior's (its low end
+   * less 10 km/h) and the estimate's own (its point less one standard error, h / 2): at 400 km/h WATCH, WARN above */
   hm_margin_estimate wide = g;
   wide.conicity_se = 0.05;
   wide.conicity_low = 0.06;
@@ -342,18 +344,26 @@ static void levels_with_a_conicity_estimate(void) {
            "uncertain estimate: conicity %g, from estimate %d", s.conicity, s.conicity_from_estimate);
   HM_CHECK_DELTA(s.hopf_low_kmh, hopf_closed_form(0.26), 1e-9, "uncertain estimate: low end");
   HM_CHECK_DELTA(s.hopf_high_kmh, hopf_closed_form(0.1358 - 0.03), 1e-9, "uncertain estimate: high end");
-  HM_CHECK(s.level == HM_LEVEL_WARN && s.reason == HM_REASON_NEAR_HOPF, "uncertain estimate at 400 km/h: %s",
+  const double from_e = hopf_closed_form(0.16) - 0.5 * (hopf_closed_form(0.16) - hopf_closed_form(0.26));
+  HM_CHECK_DELTA(s.warn_from_kmh, fmin(hopf_closed_form(0.1658) - 10.0, from_e), 1e-9, "uncertain estimate: WARN from");
+  HM_CHECK(s.level == HM_LEVEL_WATCH && s.reason == HM_REASON_APPROACHING_HOPF, "uncertain estimate at 400 km/h: %s",
            hm_level_name(s.level));
   hm_alarm_destroy(a);
+  a = make_prior(0.0, 0.0);
+  e = estimate(from_e + 0.5, 0.0);
+  HM_CHECK(hm_alarm_update(a, &e, &wide, 0.0, &s) == HM_OK && s.level == HM_LEVEL_WARN &&
+               s.reason == HM_REASON_NEAR_HOPF,
+           "uncertain estimate at %.1f km/h: %s", from_e + 0.5, hm_level_name(s.level));
+  hm_alarm_destroy(a);
   /* the model-free interval 30 km/h lower (and valid): its lower end does not count from two windows, does from
-   * three (WARN from the point less sqrt(h^2 + 10^2), h now down to the model-free end) */
+   * three (WARN from the point less h / 2, h now down to the model-free end; from two, WATCH there) */
   hm_margin_estimate lower = g;
   lower.hopf_free_valid = 1;
   lower.hopf_free_kmh = g.hopf_model_kmh - 30.0;
   lower.hopf_free_low_kmh = g.hopf_model_low_kmh - 30.0;
   lower.hopf_free_high_kmh = g.hopf_model_high_kmh - 30.0;
   const double h_free = g.hopf_model_kmh - lower.hopf_free_low_kmh;
-  const double v_free = g.hopf_model_kmh - sqrt(h_free * h_free + 100.0) + 0.5;
+  const double v_free = g.hopf_model_kmh - fmax(10.0, h_free / 2.0) + 0.5;
   e = estimate(v_free, 0.0);
   for (unsigned n = 2; n <= 3; ++n) {
     lower.n_windows = n;
@@ -361,7 +371,7 @@ static void levels_with_a_conicity_estimate(void) {
     HM_CHECK(hm_alarm_update(a, &e, &lower, 0.0, &s) == HM_OK, "update");
     HM_CHECK_DELTA(s.hopf_low_kmh, n == 3 ? lower.hopf_free_low_kmh : g.hopf_model_low_kmh, 1e-9, "low end");
     HM_CHECK_DELTA(s.hopf_high_kmh, g.hopf_model_high_kmh, 1e-9, "high end (no mismatch: the model's)");
-    HM_CHECK(s.level == (n == 3 ? HM_LEVEL_WARN : HM_LEVEL_OK), "model-free lower, %u windows: %s", n,
+    HM_CHECK(s.level == (n == 3 ? HM_LEVEL_WARN : HM_LEVEL_WATCH), "model-free lower, %u windows: %s", n,
              hm_level_name(s.level));
     hm_alarm_destroy(a);
   }
