@@ -143,6 +143,19 @@ typedef struct {
  * [s] at that trend would call for the present level again (no level down and up again within 30 s on a ramp). */
 #define HM_ALARM_TREND_S 5.0
 #define HM_ALARM_LOWER_LOOKAHEAD_S 30.0
+/* A sustained acceleration raises WARN and WATCH early below an identified interval (a driver needs time to act: WARN
+ * at least 10 s before the wheelset passes 3 mm on a ramp of 0.5 km/h/s, issue #18): the speed thresholds are judged
+ * on the speed the acceleration reaches in HM_ALARM_RAISE_LOOKAHEAD_S [s]. Not below the prior's range: its lower end
+ * is already the cautious end of the wheels' wear, and anticipating on it as well warned 71 km/h below the Hopf speed
+ * of new wheels on a ramp of 0.5 km/h/s (test_monitor_sim). The acceleration is the least of the slopes between the mean
+ * speeds of the last HM_ALARM_ACCEL_BLOCKS + 1 blocks of HM_ALARM_ACCEL_BLOCK_S [s] (10 s), 0 unless every one is
+ * positive, at most HM_ALARM_MAX_ACCEL_KMH_S (a high-speed train's, about 0.3 m/s^2): a step of the speed signal (a
+ * sensor's jump, a simulator's step profile) moves one or two block means and no more, and the speed sensor's noise
+ * (0.3 km/h r.m.s. over blocks of 10-50 samples) moves a slope by about 0.03 km/h/s (under 1 km/h ahead). */
+#define HM_ALARM_RAISE_LOOKAHEAD_S 20.0
+#define HM_ALARM_ACCEL_BLOCK_S 2.5
+#define HM_ALARM_ACCEL_BLOCKS 4u
+#define HM_ALARM_MAX_ACCEL_KMH_S 1.0
 /* An estimate in use stays in use while its standard error is at most this times conicity_max_se. */
 #define HM_ALARM_SE_HYSTERESIS 1.25
 /* The model-free interval's lower end counts for the level from this many windows on (and with model_mismatch). */
@@ -166,6 +179,9 @@ typedef struct {
   hm_table_lookup_result boundaries;/* at the conicity in use and the current speed */
   double hopf_low_kmh, hopf_high_kmh; /* the Hopf interval the level uses */
   double warn_from_kmh, watch_from_kmh; /* speeds from which the Hopf interval gives WARN and WATCH (no hysteresis) */
+  double anticipation_kmh;          /* added to the speed for those thresholds below an identified interval: the
+                                       sustained acceleration times HM_ALARM_RAISE_LOOKAHEAD_S (0 when not accelerating
+                                       or on the prior) */
   int hopf_low_from_hunting;        /* hopf_low_kmh is the lowest speed at which the held ALARM's oscillation met a
                                        criterion (below the interval the estimate or prior gave) */
   double edge_used_m;               /* the edge amplitude the amplitude rules use (0: none) */

@@ -27,6 +27,10 @@ struct hm_alarm_s {
   int precise;            /* the estimate was used alone at the last update with data (its hysteresis) */
   double v_prev_kmh, t_prev_s, dvdt_kmh_s; /* the speed's trend: an exponential average of dv/dt over ~5 s */
   int have_trend;
+  /* a sustained acceleration (alarm.h): the mean speed of the block being filled and of the last full blocks */
+  double block_sum_kmh, block_sum_t_s, block_t0_s;
+  unsigned block_n, n_blocks;
+  double block_v_kmh[HM_ALARM_ACCEL_BLOCKS + 1], block_t_s[HM_ALARM_ACCEL_BLOCKS + 1]; /* oldest first */
   /* the last table lookups (at the conicity in use and at the interval's optimistic end), reused while their
    * conicity and the speed are unchanged */
   struct {
@@ -177,6 +181,7 @@ void hm_alarm_reset(hm_alarm a) {
   a->precise = 0;
   a->have_trend = 0;
   a->dvdt_kmh_s = 0.0;
+  a->block_n = a->n_blocks = 0;
   a->cache[0].valid = a->cache[1].valid = 0;
 }
 
@@ -238,8 +243,9 @@ static hm_level raw_level(const hm_alarm a, const hm_estimate *e, const hm_margi
   if (edge > 0.0 && amp >= edge * (1.0 - ha_alarm)) return *reason = HM_REASON_AMPLITUDE_BEYOND_EDGE, HM_LEVEL_ALARM;
   if (edge > 0.0 && amp >= edge * (c->warn_amplitude_fraction - ha_warn))
     return *reason = HM_REASON_AMPLITUDE_NEAR_EDGE, HM_LEVEL_WARN;
-  if (v >= s->warn_from_kmh - hv_warn) return *reason = HM_REASON_NEAR_HOPF, HM_LEVEL_WARN;
-  if (v >= s->watch_from_kmh - hv_watch)
+  const double v_ahead = v + s->anticipation_kmh; /* the speed thresholds anticipate a sustained acceleration */
+  if (v_ahead >= s->warn_from_kmh - hv_warn) return *reason = HM_REASON_NEAR_HOPF, HM_LEVEL_WARN;
+  if (v_ahead >= s->watch_from_kmh - hv_watch)
     return *reason = HM_REASON_APPROACHING_HOPF, HM_LEVEL_WATCH;
   if (g && g->model_mismatch) return *reason = HM_REASON_MODEL_MISMATCH, HM_LEVEL_WATCH;
   if (e->sample_rate_mismatch) return *reason = HM_REASON_RATE_MISMATCH, HM_LEVEL_WATCH;
@@ -265,6 +271,37 @@ static hm_status lookup(hm_alarm a, int k, double conicity, double speed_kmh, hm
   a->cache[k].r = r;
   *out = r;
   return HM_OK;
+}
+
+/* The speed into the block being filled; a full block (HM_ALARM_ACCEL_BLOCK_S) joins the last ones. The sustained
+ * acceleration [km/h/s]: the least of the slopes between consecutive block means over the last
+ * HM_ALARM_ACCEL_BLOCKS of them, 0 unless all are positive, at most HM_ALARM_MAX_ACCEL_KMH_S (alarm.h). A time step
+ * back or a gap longer than two blocks starts again. */
+static double sustained_acceleration(hm_alarm a, double now, double v_kmh) {
+  const double block_s = HM_ALARM_ACCEL_BLOCK_S;
+  if (a->block_n > 0 && (now < a->block_t0_s || now - a->block_t0_s > 2.0 * block_s)) a->block_n = a->n_blocks = 0;
+  if (a->block_n == 0) a->block_t0_s = now, a->block_sum_kmh = a->block_sum_t_s = 0.0;
+  a->block_sum_kmh += v_kmh;
+  a->block_sum_t_s += now - a->block_t0_s;
+  ++a->block_n;
+  if (now - a->block_t0_s >= block_s) {
+    if (a->n_blocks == HM_ALARM_ACCEL_BLOCKS + 1) {
+      memmove(a->block_v_kmh, a->block_v_kmh + 1, HM_ALARM_ACCEL_BLOCKS * sizeof(double));
+      memmove(a->block_t_s, a->block_t_s + 1, HM_ALARM_ACCEL_BLOCKS * sizeof(double));
+      --a->n_blocks;
+    }
+    a->block_v_kmh[a->n_blocks] = a->block_sum_kmh / a->block_n;
+    a->block_t_s[a->n_blocks] = a->block_t0_s + a->block_sum_t_s / a->block_n;
+    ++a->n_blocks;
+    a->block_n = 0;
+  }
+  if (a->n_blocks < HM_ALARM_ACCEL_BLOCKS + 1) return 0.0;
+  double least = HM_ALARM_MAX_ACCEL_KMH_S;
+  for (unsigned k = 0; k < HM_ALARM_ACCEL_BLOCKS; ++k) {
+    const double dt = a->block_t_s[k + 1] - a->block_t_s[k];
+    least = fmin(least, dt > 0.0 ? (a->block_v_kmh[k + 1] - a->block_v_kmh[k]) / dt : 0.0);
+  }
+  return fmax(least, 0.0);
 }
 
 /* The conicity in use, the Hopf interval and the boundaries at the current speed; the table's status on failure. */
@@ -348,6 +385,7 @@ hm_status hm_alarm_update(hm_alarm a, const hm_estimate *e, const hm_margin_esti
     reason = !e->sample_rate_supported ? HM_REASON_BAD_SAMPLE_RATE
              : !e->accel_valid         ? HM_REASON_NO_ACCEL
                                        : HM_REASON_NO_SPEED;
+    a->block_n = a->n_blocks = 0; /* no speed: the acceleration starts again */
   } else {
     const hm_status st = assess(a, e, g, &s);
     if (st != HM_OK) return st;
@@ -375,6 +413,9 @@ hm_status hm_alarm_update(hm_alarm a, const hm_estimate *e, const hm_margin_esti
     a->have_trend = 1;
     a->v_prev_kmh = e->speed_kmh;
     a->t_prev_s = now;
+    /* (an identified interval only: the prior's range is already the cautious end of the wheels' wear) */
+    const double accel_kmh_s = sustained_acceleration(a, now, e->speed_kmh);
+    s.anticipation_kmh = s.conicity_from_estimate ? accel_kmh_s * HM_ALARM_RAISE_LOOKAHEAD_S : 0.0;
     target = raw_level(a, e, g, &s, a->level, &reason);
     if (target < a->level && a->dvdt_kmh_s > 0.0) {
       /* a lower level only if it would still hold at the speed the present acceleration reaches in
