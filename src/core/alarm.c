@@ -28,7 +28,7 @@ struct hm_alarm_s {
   double v_prev_kmh, t_prev_s, dvdt_kmh_s; /* the speed's trend: an exponential average of dv/dt over ~5 s */
   int have_trend;
   /* a sustained acceleration (alarm.h): the mean speed of the block being filled and of the last full blocks */
-  double block_sum_kmh, block_sum_t_s, block_t0_s;
+  double block_sum_kmh, block_sum_t_s, block_t0_s, block_last_s;
   unsigned block_n, n_blocks;
   double block_v_kmh[HM_ALARM_ACCEL_BLOCKS + 1], block_t_s[HM_ALARM_ACCEL_BLOCKS + 1]; /* oldest first */
   /* the last table lookups (at the conicity in use and at the interval's optimistic end), reused while their
@@ -273,28 +273,35 @@ static hm_status lookup(hm_alarm a, int k, double conicity, double speed_kmh, hm
   return HM_OK;
 }
 
+/* The block being filled joins the last ones (the oldest dropped beyond HM_ALARM_ACCEL_BLOCKS + 1). */
+static void close_block(hm_alarm a) {
+  if (a->n_blocks == HM_ALARM_ACCEL_BLOCKS + 1) {
+    memmove(a->block_v_kmh, a->block_v_kmh + 1, HM_ALARM_ACCEL_BLOCKS * sizeof(double));
+    memmove(a->block_t_s, a->block_t_s + 1, HM_ALARM_ACCEL_BLOCKS * sizeof(double));
+    --a->n_blocks;
+  }
+  a->block_v_kmh[a->n_blocks] = a->block_sum_kmh / a->block_n;
+  a->block_t_s[a->n_blocks] = a->block_t0_s + a->block_sum_t_s / a->block_n;
+  ++a->n_blocks;
+  a->block_n = 0;
+}
+
 /* The speed into the block being filled; a full block (HM_ALARM_ACCEL_BLOCK_S) joins the last ones. The sustained
  * acceleration [km/h/s]: the least of the slopes between consecutive block means over the last
- * HM_ALARM_ACCEL_BLOCKS of them, 0 unless all are positive, at most HM_ALARM_MAX_ACCEL_KMH_S (alarm.h). A time step
- * back or a gap longer than two blocks starts again. */
+ * HM_ALARM_ACCEL_BLOCKS of them, 0 unless all are positive, at most HM_ALARM_MAX_ACCEL_KMH_S (alarm.h). Updates
+ * further apart than a block give a block each (the one in progress is closed first); a time step back or a silence
+ * as long as the blocks' whole span starts again. */
 static double sustained_acceleration(hm_alarm a, double now, double v_kmh) {
   const double block_s = HM_ALARM_ACCEL_BLOCK_S;
-  if (a->block_n > 0 && (now < a->block_t0_s || now - a->block_t0_s > 2.0 * block_s)) a->block_n = a->n_blocks = 0;
+  if (a->block_n + a->n_blocks > 0 &&
+      (now < a->block_last_s || now - a->block_last_s > HM_ALARM_ACCEL_BLOCKS * block_s))
+    a->block_n = a->n_blocks = 0;
+  if (a->block_n > 0 && now - a->block_t0_s >= block_s) close_block(a);
+  a->block_last_s = now;
   if (a->block_n == 0) a->block_t0_s = now, a->block_sum_kmh = a->block_sum_t_s = 0.0;
   a->block_sum_kmh += v_kmh;
   a->block_sum_t_s += now - a->block_t0_s;
   ++a->block_n;
-  if (now - a->block_t0_s >= block_s) {
-    if (a->n_blocks == HM_ALARM_ACCEL_BLOCKS + 1) {
-      memmove(a->block_v_kmh, a->block_v_kmh + 1, HM_ALARM_ACCEL_BLOCKS * sizeof(double));
-      memmove(a->block_t_s, a->block_t_s + 1, HM_ALARM_ACCEL_BLOCKS * sizeof(double));
-      --a->n_blocks;
-    }
-    a->block_v_kmh[a->n_blocks] = a->block_sum_kmh / a->block_n;
-    a->block_t_s[a->n_blocks] = a->block_t0_s + a->block_sum_t_s / a->block_n;
-    ++a->n_blocks;
-    a->block_n = 0;
-  }
   if (a->n_blocks < HM_ALARM_ACCEL_BLOCKS + 1) return 0.0;
   double least = HM_ALARM_MAX_ACCEL_KMH_S;
   for (unsigned k = 0; k < HM_ALARM_ACCEL_BLOCKS; ++k) {

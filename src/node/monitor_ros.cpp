@@ -345,6 +345,7 @@ void MonitorRos::onTimer(const ros::TimerEvent&) {
   m.hopf_speed_kmh_high = s.boundaries_valid ? finite(s.hopf_high_kmh) : 0.0;
   m.warn_from_kmh = s.boundaries_valid ? finite(s.warn_from_kmh) : 0.0;
   m.watch_from_kmh = s.boundaries_valid ? finite(s.watch_from_kmh) : 0.0;
+  m.anticipation_kmh = s.boundaries_valid ? finite(s.anticipation_kmh) : 0.0;
   m.lowest_cycle_speed_kmh = s.boundaries_valid ? finite(b.lowest_cycle_speed_kmh) : 0.0;
   m.margin_to_hopf_kmh = s.boundaries_valid ? finite(s.margin_hopf_kmh) : 0.0;
   m.margin_to_lowest_cycle_kmh = s.boundaries_valid ? finite(s.margin_lowest_cycle_kmh) : 0.0;

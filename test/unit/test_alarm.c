@@ -491,7 +491,7 @@ static void prior_before_identification(void) {
 /* A sustained acceleration raises WARN early below an identified interval (alarm.h): the thresholds are judged on the
  * speed 20 s ahead. References: a ramp at a km/h/s gives the anticipation a x 20 km/h once five 2.5 s blocks are in
  * (the slope between block means of a straight line is exact), so WARN comes when v + 20 a reaches warn_from; below
- * the prior's range none (WARN when v itself reaches it); a step of the speed signal (40 km/h in one update, steady
+ * the prior's range none (WARN when v itself reaches it); updates 5 s apart the same; a step of the speed signal (40 km/h in one update, steady
  * before and after) and a steady speed with the speed sensor's noise (0.3 km/h r.m.s. at 20 Hz) anticipate nothing
  * beyond the noise's bound (1 km/h); braking anticipates nothing. */
 static void anticipates_a_sustained_acceleration(void) {
@@ -534,6 +534,14 @@ static void anticipates_a_sustained_acceleration(void) {
              t_expected);
     hm_alarm_destroy(a);
   }
+  /* updates 5 s apart (a slow status rate): a block each, the same anticipation */
+  a = make();
+  for (int k = 0; k <= 6; ++k) {
+    e = estimate(400.0 + 0.5 * 5.0 * k, 0.0);
+    HM_CHECK(hm_alarm_update(a, &e, &g, 5.0 * k, &s) == HM_OK, "update");
+  }
+  HM_CHECK_DELTA(s.anticipation_kmh, 10.0, 1e-9, "updates 5 s apart on a ramp of 0.5 km/h/s");
+  hm_alarm_destroy(a);
   /* a step of 40 km/h to 5 km/h below the threshold, with the sensor's noise; then braking at 0.5 km/h/s */
   a = make();
   double most = 0.0;
