@@ -28,8 +28,10 @@
  * -6.1..-6.8 depending on the excitation's colour. A quadratic background left the decay rate 10% small in magnitude
  * at 420-460 km/h on the independent simulator, the cubic 5%. Bias and spread on both simulators: see README.
  *
- * Cost: per sample three biquads and a decimation counter; per fit (every fit_interval_s) one FFT of the window
- * (4096 points at 100 Hz and 40 s) and about 5-20 scoring steps over the band's bins. No allocation after create.
+ * Cost: per sample three biquads and a decimation counter; per fit (every fit_interval_s) one real FFT of the window
+ * (4096 points at 100 Hz and 40 s, as one complex FFT of 2048), the line search, and a few scoring steps over the
+ * band's bins (about 4 from a warm start; each trial point's likelihood and scoring system in one pass, a step within
+ * tol of the optimum ends it). No allocation after create.
  */
 #ifndef HUNTING_MONITOR_MODAL_H
 #define HUNTING_MONITOR_MODAL_H
