@@ -311,6 +311,12 @@ static double sustained_acceleration(hm_alarm a, double now, double v_kmh) {
   return fmax(least, 0.0);
 }
 
+/* WARN from an identified Hopf speed (alarm.h): the point less the larger of the margin and one standard error, the
+ * lower half-width (point - low) being z of them. */
+static double warn_below_point(double point_kmh, double low_kmh, double margin_kmh, double z) {
+  return point_kmh - fmax(margin_kmh, (point_kmh - low_kmh) / z);
+}
+
 /* The conicity in use, the Hopf interval and the boundaries at the current speed; the table's status on failure. */
 static hm_status assess(hm_alarm a, const hm_estimate *e, const hm_margin_estimate *g, hm_assessment *s) {
   const hm_alarm_config *c = &a->cfg;
@@ -360,11 +366,11 @@ static hm_status assess(hm_alarm a, const hm_estimate *e, const hm_margin_estima
   const double h = precise ? b.hopf_speed_kmh - s->hopf_low_kmh : 0.0;
   const double from = precise ? b.hopf_speed_kmh : s->hopf_low_kmh;
   const double z = g && g->interval_z > 0.0 ? g->interval_z : 1.0;
-  s->warn_from_kmh = from - fmax(c->warn_speed_margin_kmh, h / z);
+  s->warn_from_kmh = warn_below_point(from, precise ? s->hopf_low_kmh : from, c->warn_speed_margin_kmh, z);
   if (have && !precise && !g->model_mismatch) {
     const double lo_e = free_counts ? fmin(g->hopf_model_low_kmh, g->hopf_free_low_kmh) : g->hopf_model_low_kmh;
-    const double from_e = g->hopf_model_kmh - fmax(c->warn_speed_margin_kmh, (g->hopf_model_kmh - lo_e) / z);
-    s->warn_from_kmh = fmin(a->prior_hopf_low_kmh - c->warn_speed_margin_kmh, from_e);
+    s->warn_from_kmh = fmin(a->prior_hopf_low_kmh - c->warn_speed_margin_kmh,
+                            warn_below_point(g->hopf_model_kmh, lo_e, c->warn_speed_margin_kmh, z));
   }
   s->watch_from_kmh = from - hypot(h, c->watch_speed_margin_kmh);
   /* the edge: at the conicity in use where the origin is stable there; inside the Hopf interval above the point

@@ -298,9 +298,10 @@ static void bad_configuration_and_input(void) {
 
 /* With a conicity estimate (0.16 +- 0.003, as margin.h makes them): the Hopf interval is the closed form's at the
  * interval's conicities; WARN from the point less the larger of the 10 km/h margin and one standard error (h / 2, the
- * interval's lower half-width h in standard errors), WATCH from point - sqrt(h^2 + 30^2) (in quadrature), 0.5 km/h either side; inside it above the point estimate a small oscillation is WARN, not ALARM; above it ALARM;
- * a large standard error falls back to the vehicle's conicity; a mismatch or a sensor at another rate is WATCH; a
- * rate the filters cannot use is NO_DATA. */
+ * interval's lower half-width h in standard errors), WATCH from point - sqrt(h^2 + 30^2) (in quadrature), 0.5 km/h
+ * either side; inside it above the point estimate a small oscillation is WARN, not ALARM; above it ALARM; a large
+ * standard error falls back to the vehicle's conicity; a mismatch or a sensor at another rate is WATCH; a rate the
+ * filters cannot use is NO_DATA. */
 static void levels_with_a_conicity_estimate(void) {
   const hm_margin_estimate g = identified();
   const double h = g.hopf_model_kmh - g.hopf_model_low_kmh;
@@ -490,10 +491,10 @@ static void prior_before_identification(void) {
 
 /* A sustained acceleration raises WARN early below an identified interval (alarm.h): the thresholds are judged on the
  * speed 20 s ahead. References: a ramp at a km/h/s gives the anticipation a x 20 km/h once five 2.5 s blocks are in
- * (the slope between block means of a straight line is exact), so WARN comes when v + 20 a reaches warn_from; below
- * the prior's range none (WARN when v itself reaches it); updates 5 s apart the same; a step of the speed signal (40 km/h in one update, steady
- * before and after) and a steady speed with the speed sensor's noise (0.3 km/h r.m.s. at 20 Hz) anticipate nothing
- * beyond the noise's bound (1 km/h); braking anticipates nothing. */
+ * (the slope between block means of a straight line is exact), so WARN comes when v + 20 a reaches warn_from; below the
+ * prior's range none (WARN when v itself reaches it); updates 5 s apart the same; a step of the speed signal (40 km/h
+ * in one update, steady before and after) and a steady speed with the speed sensor's noise (0.3 km/h r.m.s. at 20 Hz)
+ * anticipate nothing beyond the noise's bound (1 km/h); braking anticipates nothing. */
 static void anticipates_a_sustained_acceleration(void) {
   const hm_margin_estimate g = identified();
   hm_alarm a = make();

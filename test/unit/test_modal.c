@@ -177,14 +177,14 @@ static void joints_are_not_the_mode(void) {
   }
 }
 
-/* The coverage of the decay rate's 2-standard-error intervals (issue #18), Monte Carlo over 480 windows: a pole pair
- * at 14 Hz with decay rates -0.05, -0.2, -1, -4 and -8 1/s (damping ratios 0.0006 to 0.09: from at the Hopf speed to
- * 100 km/h below it, and the 380 km/h windows of worn wheels, -7.1 1/s), windows of 20 and 40 s, input rates 2000, 1250 and 250 Hz (decimation 20, 12 and 2: the
- * periodogram zero-padded by 1.02, 1.97 and 1.64), 16 windows each, plus 10% white sensor noise. The process is the
- * pole pair's exact discretisation, x_k = 2 r cos(w0 / fs) x_k-1 - r^2 x_k-2 + e_k with r = exp(sigma / fs): its
- * spectrum has the continuous pole s = sigma + i w0 over a smooth background. Reported: the share of intervals that
- * cover sigma with the statistical error alone and with the leakage term 1 / T added linearly (as the margin adds it,
- * margin.h); the test holds the latter to at least 90% overall and 75% in every cell. */
+/* The coverage of the decay rate's 2-standard-error intervals (issue #18), Monte Carlo over 480 windows: a pole pair at
+ * 14 Hz with decay rates -0.05, -0.2, -1, -4 and -8 1/s (damping ratios 0.0006 to 0.09: from at the Hopf speed to 100
+ * km/h below it, and the 380 km/h windows of worn wheels, -7.1 1/s), windows of 20 and 40 s, input rates 2000, 1250 and
+ * 250 Hz (decimation 20, 12 and 2: the periodogram zero-padded by 1.02, 1.97 and 1.64), 16 windows each, plus 10% white
+ * sensor noise. The process is the pole pair's exact discretisation, x_k = 2 r cos(w0 / fs) x_k-1 - r^2 x_k-2 + e_k
+ * with r = exp(sigma / fs): its spectrum has the continuous pole s = sigma + i w0 over a smooth background. Reported:
+ * the share of intervals that cover sigma with the statistical error alone and with the leakage term 1 / T added
+ * linearly (as the margin adds it, margin.h); the test holds the latter to at least 90% overall and 75% in every cell. */
 static void coverage_of_the_intervals(void) {
   const double sigmas[] = {-0.05, -0.2, -1.0, -4.0, -8.0}, windows[] = {20.0, 40.0}, rates[] = {2000.0, 1250.0, 250.0};
   const int per_cell = 16;
