@@ -2,20 +2,15 @@
  * an options byte). An accepted fit must be finite. */
 #include <math.h>
 #include <stdint.h>
-#include <string.h>
 
+#include "fuzz_pairs.h"
 #include "hunting_monitor/conicity_fit.h"
 
 int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size) {
   if (size < 1) return 0;
   enum { MAX = 64 };
   double y[MAX], l[MAX];
-  size_t n = (size - 1) / 16;
-  if (n > MAX) n = MAX;
-  for (size_t i = 0; i < n; ++i) {
-    memcpy(&y[i], data + 1 + 16 * i, 8);
-    memcpy(&l[i], data + 9 + 16 * i, 8);
-  }
+  const size_t n = fuzz_pairs(data, size, 1, y, l, MAX);
   hm_fit_options o;
   hm_fit_options_default(&o);
   o.n_terms = 1 + data[0] % 3;

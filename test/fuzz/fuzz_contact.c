@@ -5,6 +5,7 @@
 #include <stdint.h>
 #include <string.h>
 
+#include "fuzz_pairs.h"
 #include "hunting_monitor/contact.h"
 
 int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size) {
@@ -12,13 +13,8 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size) {
   enum { MAX = 128 };
   double w[2][MAX], r[2][MAX];
   const size_t pairs = (size - 1) / 16, nw = pairs / 2 > MAX ? MAX : pairs / 2, nr = pairs - nw > MAX ? MAX : pairs - nw;
-  for (size_t i = 0; i < nw + nr; ++i) {
-    double y, z;
-    memcpy(&y, data + 1 + 16 * i, 8);
-    memcpy(&z, data + 9 + 16 * i, 8);
-    if (i < nw) w[0][i] = y, w[1][i] = z;
-    else r[0][i - nw] = y, r[1][i - nw] = z;
-  }
+  fuzz_pairs(data, size, 1, w[0], w[1], nw);
+  fuzz_pairs(data, size, 1 + 16 * nw, r[0], r[1], nr);
   hm_contact_config c;
   hm_contact_config_default(&c);
   c.inclination = (data[0] % 3) / 40.0;

@@ -5,6 +5,7 @@
 #include <stdint.h>
 #include <string.h>
 
+#include "fuzz_pairs.h"
 #include "hunting_monitor/eqcon.h"
 
 int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size) {
@@ -12,12 +13,7 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size) {
   enum { MAX = 256 };
   double y[MAX], dr[MAX], amp;
   memcpy(&amp, data + 1, 8);
-  size_t n = (size - 9) / 16;
-  if (n > MAX) n = MAX;
-  for (size_t i = 0; i < n; ++i) {
-    memcpy(&y[i], data + 9 + 16 * i, 8);
-    memcpy(&dr[i], data + 17 + 16 * i, 8);
-  }
+  const size_t n = fuzz_pairs(data, size, 9, y, dr, MAX);
   hm_eqcon_config c;
   hm_eqcon_config_default(&c);
   hm_eqcon e = NULL;
