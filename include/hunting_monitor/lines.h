@@ -14,7 +14,9 @@
  *    bin: 3e-4 at the default 8, so a few in a band of a thousand bins, which is why one line alone is never taken
  *    for a comb);
  *  - the candidates' frequencies are refined by a parabola through the logarithms of the three bins at the peak;
- *  - a comb is a fundamental f1 >= min_fundamental_hz with at least min_harmonics candidates within
+ *  - a comb is a fundamental f1 >= min_fundamental_hz with at least min_harmonics candidates (or, where fewer
+ *    whole multiples of f1 lie in the range, all of them and at least two: a pattern of 6.45 m at 350 km/h, f1 15 Hz,
+ *    has two in 2.5-30 Hz) within
  *    (0.5 + 0.5 m / n) / T of whole multiples m f1 (f1 tried as each candidate's frequency over n = 1..12). The comb
  *    kept scores best: one per candidate on a tooth, less one half per tooth in the range without one (a
  *    sub-harmonic comb f1 / j holds every line of f1 and some chance candidates but misses most of its teeth), then
@@ -51,6 +53,9 @@ void hm_lines_config_default(hm_lines_config *cfg);
 /* HM_EDOMAIN with "field: reason" in why for an invalid configuration. */
 hm_status hm_lines_config_validate(const hm_lines_config *cfg, char *why, size_t why_len);
 
+/* Lone candidates reported at most (the strongest). */
+#define HM_LINES_MAX_LONE 4
+
 typedef struct {
   int found;                /* a comb was found */
   double fundamental_hz;    /* its spacing f1 [Hz] (0 if none) */
@@ -60,6 +65,11 @@ typedef struct {
   double strongest_ratio;
   size_t strongest_bin;
   size_t bins_excluded;     /* bins marked in exclude */
+  /* candidates on no comb (all of them when none was found), strongest first: a lone line (a slab's fundamental, a
+   * machine's frequency) or the peak of a lightly damped mode; the identification tells them apart (modal.h) */
+  unsigned n_lone;
+  double lone_hz[HM_LINES_MAX_LONE], lone_ratio[HM_LINES_MAX_LONE];
+  size_t lone_bin[HM_LINES_MAX_LONE];
 } hm_lines_result;
 
 typedef struct hm_lines_s *hm_lines;
@@ -67,6 +77,24 @@ typedef struct hm_lines_s *hm_lines;
 /* For spectra of at most max_bins bins. HM_EDOMAIN (reason in why) for a bad configuration, HM_ENOMEM. */
 hm_status hm_lines_create(const hm_lines_config *cfg, size_t max_bins, hm_lines *out, char *why, size_t why_len);
 void hm_lines_destroy(hm_lines l);
+
+/* Mark in exclude[0..n) the bins of one line at f_hz, ratio times its background, in a window of window_s seconds (the
+ * width the comb's teeth get, above); the number of bins newly marked. */
+size_t hm_lines_mark(const hm_lines l, double f_hz, double ratio, size_t n, double df_hz, double window_s,
+                     unsigned char *exclude);
+
+/*
+ * Is the peak at bin k a sinusoid (a harmonic F test)? The rectangular window of n_samples samples (zero-padded to
+ * nfft) turns a line at w into the kernel D(w_j - w) at the bins j about it: the complex DFT (re, im) over k -+ 3
+ * bins per 1 / T is fitted by one line (its frequency within -+0.6 of 1 / T of the bin, its complex amplitude by least
+ * squares) and F = (power explained / 2) / (residual / (2 (2m + 1) - 2)) returned for the 2m + 1 bins. Over a spectrum
+ * that is smooth across them (a mode broader than about 3 / T, noise) the bins are independent and F follows
+ * F(2, 2 (2m + 1) - 2) (12 degrees of freedom without padding: P(F > 20) = 1.5e-4, a little more for the search in
+ * frequency); a line leaves the continuum only and F grows with its power. A mode narrower than about 1 / T is,
+ * within one window, a line too. NAN for bad arguments.
+ */
+double hm_lines_sinusoid_f(const double *re, const double *im, size_t nbins, size_t k, size_t n_samples,
+                           size_t nfft);
 
 /*
  * Look for a comb in power[0..n) (bin k at k df_hz) between f_lo_hz and f_hi_hz, for a window of window_s seconds.

@@ -6,20 +6,34 @@
  *  - The signal is high-passed (2nd-order Butterworth at 2 Hz: drift and curving), low-passed (4th-order at 0.3 of
  *    the decimated rate: anti-aliasing) and decimated to about decimated_rate_hz; the window's periodogram
  *    I_k (rectangular window, zero-padded to a power of two) is taken over [band_low_hz, band_high_hz].
- *  - The spectral model is one lightly damped mode over a smooth background plus white sensor noise:
- *        S(w) = exp(c0 + c1 u + c2 u^2 + c3 u^3) / |(iw - s)(iw - conj s)|^2 + N,  s = sigma + i w0, u = ln(w / w_ref).
- *    The mode is the hunting pair of the linear model (its poles are s); the background exp(cubic in ln w)
- *    takes what is smooth across the band: the second, heavily damped pair of the same model (damping ratio about
- *    0.6 at the same frequency), the s^2 of acceleration, the filters and the colour of the track excitation, which
- *    differs between tracks and is not known.
- *  - Lines are not the mode (issue #18): a comb of lines at multiples of V / L (rail joints, bridge spans, slabs;
- *    lines.h, searched over 2.5 Hz to 0.3 of the decimated rate) is reported and its bins are left out of the fit, so
- *    that a line on the mode's peak is never read as the mode's damping.
+ *  - The spectral model (whittle.h, private) is one lightly damped mode, or two (the likelihood chooses), over a
+ *    smooth numerator and white sensor noise:
+ *        S(w) = exp(c0 + c1 u + c2 u^2 + c3 u^3) [P(s1, w) + rho P(s2, w)] + N,  s = sigma + i w0, u = ln(w / w_ref),
+ *    P the pole pair's Lorentzian widened by the window's leakage (2 / T: a line and a mode far narrower than 1 / T
+ *    are its sigma = 0). The mode is the hunting pair of the linear model; the numerator takes what is smooth across
+ *    the band: the second, heavily damped pair of the same model (damping ratio about 0.6 at the same frequency), the
+ *    s^2 of acceleration, the filters and the colour of the track excitation, which differs between tracks and is
+ *    not known. A second pair holds a resonance the numerator cannot, 1-3 Hz wide beside the mode (a bogie frame's,
+ *    the installation's): chosen when 2 (L1 - L2) over the independent ordinates exceeds HM_MODAL_TWO_PAIR_LR and its
+ *    less damped pair is the one pair's peak (inside its width, its top, above the other pair), so that a chance bump
+ *    is not a mode. The hunting mode is the less damped pair: averaged with a broad resonance at its frequency a
+ *    single pair reads -2.5 1/s for a mode of -0.56 (issue #26).
+ *  - Lines are not the mode (issues #18, #26). A comb of lines at multiples of V / L (rail joints, bridge spans,
+ *    slabs; lines.h, searched over 2.5 Hz to 0.3 of the decimated rate, two teeth where only two fit) is reported and
+ *    its bins are left out. A lone candidate line is a line when a harmonic F test says so (one sinusoid explains its
+ *    main lobe, lines.h; F >= HM_MODAL_LINE_F): set aside and reported (lone_lines), unless the mode sits on it while
+ *    as narrow as a line: then a line and the mode near its Hopf speed look alike in this window (a mode narrower
+ *    than about 1 / T is, over T seconds, a sinusoid) and both readings are given, the mode's and line_reading
+ *    without it (narrow_peak): the margin decides with the model and what it knows (margin.h).
+ *  - A reading is valid when converged, lightly damped (damping ratio below 0.5), a peak (over 3 times the band's
+ *    mean), inside the band, and informative (the decay rate's standard error at most HM_MODAL_INFORMATIVE_SE_1_S +
+ *    HM_MODAL_INFORMATIVE_REL |sigma|).
  *  - Whittle's log-likelihood  -sum(ln S_k + I_k / S_k)  is maximised by Fisher scoring with Levenberg damping
- *    (J = d ln S / d theta, step (J'J + mu D)^-1 J'(I/S - 1)), warm-started from the previous fit; converged when
- *    the objective changes by less than tol relative (failure: HM_ENOCONV after max_iter). The standard errors are
- *    the square roots of the diagonal of (J'J)^-1, Whittle's asymptotic covariance, scaled by nfft / n: the bins of
- *    a periodogram zero-padded from n to nfft points are not independent (about n of them are).
+ *    (J = d ln S / d theta, step (J'J + mu D)^-1 J'(I/S - 1)), warm-started from the previous fit (a decay rate at
+ *    its bound 0 held there: an active set); converged when the objective changes by less than tol relative
+ *    (failure: HM_ENOCONV after max_iter). The standard errors are the square roots of the diagonal of (J'J)^-1,
+ *    Whittle's asymptotic covariance, scaled by nfft / n: the bins of a periodogram zero-padded from n to nfft points
+ *    are not independent (about n of them are).
  *  - A stationary spectrum gives |sigma| but not its sign: the decay rate reported is -|sigma|. Growth (sigma > 0) is
  *    seen by the amplitude tracker and the alarm, not here.
  * Why not an AR model of the acceleration: the second mode at the same frequency and the double zero at DC of
@@ -29,9 +43,10 @@
  * at 420-460 km/h on the independent simulator, the cubic 5%. Bias and spread on both simulators: see README.
  *
  * Cost: per sample three biquads and a decimation counter; per fit (every fit_interval_s) one real FFT of the window
- * (4096 points at 100 Hz and 40 s, as one complex FFT of 2048), the line search, and a few scoring steps over the
- * band's bins (about 4 from a warm start; each trial point's likelihood and scoring system in one pass, a step within
- * tol of the optimum ends it). No allocation after create.
+ * (4096 points at 100 Hz and 40 s, as one complex FFT of 2048), the line search and the F test of its lone
+ * candidates, a few scoring steps of one pair from a warm start, the two-pair fit from its warm start (and from two
+ * splits of the one pair every fifth fit, a start given up after a few steps when it cannot reach the
+ * choice), and with a narrow peak the line reading's fits. No allocation after create.
  */
 #ifndef HUNTING_MONITOR_MODAL_H
 #define HUNTING_MONITOR_MODAL_H
@@ -64,6 +79,28 @@ void hm_modal_config_default(hm_modal_config *cfg);
 /* HM_EDOMAIN with "field: reason" in why for an invalid configuration. */
 hm_status hm_modal_config_validate(const hm_modal_config *cfg, char *why, size_t why_len);
 
+/* Lone lines reported at most. */
+#define HM_MODAL_MAX_LONE 4
+
+/* One reading of the window: the hunting mode as the fit sees it over a set of bins. */
+typedef struct {
+  int valid;                   /* converged, the mode inside the band, lightly damped, a peak, and informative */
+  int informative;             /* the decay rate's standard error is at most HM_MODAL_INFORMATIVE_SE_1_S plus
+                                  HM_MODAL_INFORMATIVE_REL of |sigma| (a fit that cannot tell the damping is no mode) */
+  double frequency_hz, frequency_se_hz;        /* damped natural frequency w0 / 2 pi */
+  double decay_rate_1_s, decay_rate_se_1_s;    /* sigma = -|Re s| [1/s] (negative: decaying) */
+  double damping_ratio, damping_ratio_se;      /* -sigma / |s| */
+  double peak_to_mean;         /* the mode's spectral peak over the band's mean level (valid needs > 3) */
+  unsigned poles;              /* pole pairs the likelihood chose: 1, or 2 (a second resonance beside the mode) */
+  double second_frequency_hz, second_decay_rate_1_s; /* the other pair of two (0 with one) */
+  double two_pair_lr;          /* 2 (L1 - L2) over the independent ordinates: two pairs are chosen above
+                                  HM_MODAL_TWO_PAIR_LR (0 when the two-pair fit did not converge) */
+  double peak_core_z;          /* the periodogram's excess over the fit within half the mode's width of its frequency,
+                                  in standard deviations: a narrower resonance inside the fitted peak (the mode
+                                  beside a broad one, averaged with it) shows as a large positive value */
+  unsigned iterations;         /* scoring steps of the fits of this reading */
+} hm_mode_reading;
+
 typedef struct {
   int valid;                   /* the fit converged with the mode inside the band */
   double window_s;             /* data in the window [s] */
@@ -72,6 +109,9 @@ typedef struct {
   double damping_ratio, damping_ratio_se;      /* -sigma / |s| */
   double peak_to_mean;         /* the mode's spectral peak over the band's mean level (valid needs > 3) */
   unsigned iterations;         /* scoring steps of this fit */
+  int informative;             /* as in hm_mode_reading */
+  unsigned poles;              /* as in hm_mode_reading */
+  double second_frequency_hz, second_decay_rate_1_s, two_pair_lr, peak_core_z;
   /* a periodic excitation of the track found in the window (lines.h), whose bins the fit left out */
   int lines_found;
   double line_fundamental_hz;  /* the comb's spacing: V / L for a pattern every L metres */
@@ -79,7 +119,30 @@ typedef struct {
   double line_strongest_hz;    /* its strongest line and that line's acceleration amplitude [m/s^2] */
   double line_strongest_mps2;
   double band_excluded_fraction; /* of the band's bins left out of the fit */
+  /* lone lines in the band (candidates of lines.h on no comb) that the mode's fit does not explain: left out of the
+   * fit, strongest first, with their acceleration amplitudes */
+  unsigned lone_lines;
+  double lone_line_hz[HM_MODAL_MAX_LONE], lone_line_mps2[HM_MODAL_MAX_LONE];
+  /* the mode sits on a lone candidate and is as narrow as a line (|sigma| at most 3 / T plus two standard errors): a
+   * line and the hunting mode near its Hopf speed look alike in one window. The reading above takes it for the mode;
+   * line_reading is the window with it (and every lone line) left out. Which one holds is the margin's to decide,
+   * with the model and what is known (margin.h). */
+  int narrow_peak;
+  double narrow_peak_hz, narrow_peak_mps2;
+  hm_mode_reading line_reading;
 } hm_mode_estimate;
+
+/* A lone candidate is a line when its harmonic F statistic (lines.h) is at least this (F(2, 12) beyond it: 1.5e-4). */
+#define HM_MODAL_LINE_F 20.0
+/* A reading is informative when decay_rate_se <= HM_MODAL_INFORMATIVE_SE_1_S + HM_MODAL_INFORMATIVE_REL |sigma|. */
+#define HM_MODAL_INFORMATIVE_SE_1_S 0.5
+#define HM_MODAL_INFORMATIVE_REL 0.5
+/* Two pole pairs are chosen when 2 (L1 - L2), over the independent ordinates, exceeds this (the chi-square of three
+ * more parameters beyond its 0.03% point: a lone pair with a chance second pair almost never). */
+#define HM_MODAL_TWO_PAIR_LR 12.0
+
+/* The reading as the window's estimate (its fields copied; the window's lines kept). */
+void hm_mode_estimate_use_reading(hm_mode_estimate *e, const hm_mode_reading *r);
 
 typedef struct hm_modal_s *hm_modal;
 

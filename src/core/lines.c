@@ -74,6 +74,17 @@ typedef struct {
   size_t k;
 } candidate;
 
+size_t hm_lines_mark(const hm_lines l, double f, double ratio, size_t n, double df, double T, unsigned char *exclude) {
+  if (!l || !exclude || !(df > 0.0) || !(T > 0.0) || n == 0) return 0;
+  const hm_lines_config *c = &l->cfg;
+  const double w = fmin(c->background_halfwidth_hz, fmax(2.0 / T, sqrt(fmax(ratio, 1.0) / c->leakage) / (HM_PI * T)));
+  const double a = fmax(0.0, ceil((f - w) / df)), b = fmin((double)(n - 1), floor((f + w) / df));
+  size_t marked = 0;
+  for (double k = a; k <= b; k += 1.0)
+    if (!exclude[(size_t)k]) exclude[(size_t)k] = 1, ++marked;
+  return marked;
+}
+
 hm_status hm_lines_find(hm_lines l, const double *p, size_t n, double df, double T, double f_lo, double f_hi,
                         unsigned char *exclude, hm_lines_result *out) {
   if (!l || !p || !exclude || !out || n == 0 || n > l->max_bins || !(df > 0.0) || !(T > 0.0)) return HM_EINVAL;
@@ -143,13 +154,18 @@ hm_status hm_lines_find(hm_lines l, const double *p, size_t n, double df, double
       if (score > best_score || (score == best_score && f1 > best_f1))
         best_score = score, best_count = count, best_f1 = f1;
     }
-  r.found = best_count >= c->min_harmonics;
+  /* where fewer whole multiples of the spacing fit in the range than min_harmonics, all of them (at least two) */
+  const double best_teeth = best_f1 > 0.0 ? floor(f_hi / best_f1) - ceil(f_lo / best_f1) + 1.0 : 0.0;
+  const unsigned needed = (unsigned)fmax(2.0, fmin((double)c->min_harmonics, best_teeth));
+  r.found = best_count >= needed;
+  unsigned char on_comb[MAX_CANDIDATES] = {0};
   if (r.found) {
     /* least squares through the matched harmonics: f_j = m_j f1 */
     double smf = 0.0, smm = 0.0;
     for (size_t j = 0; j < nc; ++j) {
       const double m = floor(cand[j].f / best_f1 + 0.5);
       if (m >= 1.0 && fabs(cand[j].f - m * best_f1) <= (0.5 + 0.5 * m) / T) {
+        on_comb[j] = 1;
         smf += m * cand[j].f, smm += m * m;
         if (cand[j].ratio > r.strongest_ratio) {
           r.strongest_ratio = cand[j].ratio;
@@ -167,12 +183,51 @@ hm_status hm_lines_find(hm_lines l, const double *p, size_t n, double df, double
       double ratio = 1.0;
       for (size_t j = 0; j < nc; ++j)
         if (fabs(cand[j].f - fm) <= (0.5 + 0.5 * m) / T) ratio = fmax(ratio, cand[j].ratio);
-      const double w = fmin(c->background_halfwidth_hz, fmax(2.0 / T, sqrt(ratio / c->leakage) / (HM_PI * T)));
-      const double a = fmax(0.0, ceil((fm - w) / df)), b = fmin((double)(n - 1), floor((fm + w) / df));
-      for (double k = a; k <= b; k += 1.0)
-        if (!exclude[(size_t)k]) exclude[(size_t)k] = 1, ++r.bins_excluded;
+      r.bins_excluded += hm_lines_mark(l, fm, ratio, n, df, T, exclude);
     }
+  }
+  /* the candidates on no comb, strongest first (a candidate taken is marked 2) */
+  for (unsigned slot = 0; slot < HM_LINES_MAX_LONE; ++slot) {
+    size_t best = nc;
+    for (size_t j = 0; j < nc; ++j)
+      if (!on_comb[j] && (best == nc || cand[j].ratio > cand[best].ratio)) best = j;
+    if (best == nc) break;
+    on_comb[best] = 2;
+    r.lone_hz[slot] = cand[best].f;
+    r.lone_ratio[slot] = cand[best].ratio;
+    r.lone_bin[slot] = cand[best].k;
+    r.n_lone = slot + 1;
   }
   *out = r;
   return HM_OK;
+}
+
+/* D(d) = sum_{t<n} e^{-i d t} (d in rad per sample) as (re, im). */
+static void dirichlet(double d, size_t n, double *dr, double *di) {
+  const double h = 0.5 * d, s = sin(h);
+  const double mag = fabs(s) < 1e-12 ? (double)n : sin((double)n * h) / s, ph = -h * (double)(n - 1);
+  *dr = mag * cos(ph);
+  *di = mag * sin(ph);
+}
+
+double hm_lines_sinusoid_f(const double *re, const double *im, size_t nbins, size_t k, size_t n, size_t nfft) {
+  if (!re || !im || n < 4 || nfft < n || k >= nbins) return NAN;
+  const size_t m = (size_t)ceil(3.0 * (double)nfft / (double)n); /* -+3 bins per 1 / T */
+  if (k < m || k + m >= nbins) return NAN;
+  double total = 0.0, explained = 0.0;
+  for (size_t j = k - m; j <= k + m; ++j) total += re[j] * re[j] + im[j] * im[j];
+  for (int step = -12; step <= 12; ++step) { /* the line's frequency, in 1/20 of 1 / T about the peak's bin */
+    const double wl = 2.0 * HM_PI * ((double)k + 0.05 * step * (double)nfft / (double)n) / (double)nfft;
+    double sxr = 0.0, sxi = 0.0, sdd = 0.0;
+    for (size_t j = k - m; j <= k + m; ++j) {
+      double dr, di;
+      dirichlet(2.0 * HM_PI * (double)j / (double)nfft - wl, n, &dr, &di);
+      sxr += re[j] * dr + im[j] * di; /* X conj(D) */
+      sxi += im[j] * dr - re[j] * di;
+      sdd += dr * dr + di * di;
+    }
+    if (sdd > 0.0) explained = fmax(explained, (sxr * sxr + sxi * sxi) / sdd);
+  }
+  const double residual = total - explained, dof = 2.0 * (double)(2 * m + 1) - 2.0;
+  return residual > 0.0 ? (explained / 2.0) / (residual / dof) : INFINITY;
 }

@@ -9,9 +9,21 @@
 #include "biquad.h"
 #include "fft.h"
 #include "hunting_monitor/lines.h"
+#include "whittle.h"
 
-enum { NP = 7 }; /* sigma, w0, c0, c1, c2, c3, ln N */
-enum { P_SIGMA, P_W0, P_C0, P_C1, P_C2, P_C3, P_LN };
+enum { NPM = HM_WHITTLE_MAX_NP };
+/* The two-pair fit: at most this many scoring steps (a second pair that needs more is not there), the one pair's
+ * split starts tried every this many fits besides the warm start, and converged at this relative change of the
+ * objective (the choice by likelihood ratio needs no more). */
+enum { HM_MODAL_MAX_ITER2 = 25, HM_MODAL_SCREEN_ITER2 = 8, HM_MODAL_SPLIT_EVERY = 5 };
+#define HM_MODAL_TOL2 1e-7
+
+/* The warm start of one kind of reading (the window's, and the one with its lone lines left out). */
+typedef struct {
+  double th1[NPM], th2[NPM];
+  int have1, have2;
+  unsigned since_split;        /* fits since the two-pair fit last tried the one pair's split starts */
+} warm_start;
 
 struct hm_modal_s {
   hm_modal_config cfg;
@@ -24,12 +36,12 @@ struct hm_modal_s {
   double fit_every;            /* decimated samples between fits (fit_interval_s) */
   size_t nfft_max, nfft;
   double *re, *im, *cosw, *sinw; /* FFT work and twiddles (nfft_max / 2) */
-  double *w, *pgram, *u;       /* band bins: angular frequency, periodogram, ln(w / w_ref) */
+  double *w, *pgram, *u;       /* the bins of the reading being fitted: angular frequency, periodogram, ln(w / w_ref) */
   double *power;               /* |X_k|^2 of every bin (the line search) */
   unsigned char *excluded;     /* the bins of a comb of lines */
+  unsigned char *set_aside;    /* the comb's and the lone lines' */
   hm_lines lines;
-  double theta[NP];
-  int have_theta;
+  warm_start warm[2];          /* the window's reading, the line reading */
 };
 
 void hm_modal_config_default(hm_modal_config *c) {
@@ -141,9 +153,10 @@ hm_status hm_modal_create(const hm_modal_config *cfg, double fs, hm_modal *out, 
   m->u = malloc((m->nfft_max / 2 + 1) * sizeof(double));
   m->power = malloc((m->nfft_max / 2 + 1) * sizeof(double));
   m->excluded = malloc(m->nfft_max / 2 + 1);
+  m->set_aside = malloc(m->nfft_max / 2 + 1);
   const hm_lines_config lc = lines_config(cfg);
   if (!m->ring || !m->re || !m->im || !m->cosw || !m->sinw || !m->w || !m->pgram || !m->u || !m->power ||
-      !m->excluded || hm_lines_create(&lc, m->nfft_max / 2 + 1, &m->lines, NULL, 0) != HM_OK) {
+      !m->excluded || !m->set_aside || hm_lines_create(&lc, m->nfft_max / 2 + 1, &m->lines, NULL, 0) != HM_OK) {
     hm_modal_destroy(m);
     return HM_ENOMEM;
   }
@@ -165,6 +178,7 @@ void hm_modal_destroy(hm_modal m) {
   free(m->u);
   free(m->power);
   free(m->excluded);
+  free(m->set_aside);
   hm_lines_destroy(m->lines);
   free(m);
 }
@@ -176,7 +190,10 @@ void hm_modal_reset(hm_modal m) {
   hm_biquad_clear(&m->lp[1]);
   m->phase = 0;
   m->head = m->n_in = m->since_fit = 0;
-  m->have_theta = 0;
+  for (int k = 0; k < 2; ++k) {
+    m->warm[k].have1 = m->warm[k].have2 = 0;
+    m->warm[k].since_split = HM_MODAL_SPLIT_EVERY - 1; /* the first fit tries the splits */
+  }
 }
 
 hm_status hm_modal_set_rate(hm_modal m, double fs) {
@@ -204,149 +221,273 @@ int hm_modal_fit_due(const hm_modal m) {
   return m && m->n_in >= m->min_n && (double)m->since_fit >= m->fit_every;
 }
 
-/* S_k (its gradient of ln S_k in grad, if not NULL) for bin k; n = exp(th[P_LN]), the noise level (one exp per pass). */
-static double spectrum(const double *th, double n, double w, double u, double *grad) {
-  const double sg = th[P_SIGMA], w0 = th[P_W0];
-  const double re = sg * sg + w0 * w0 - w * w, d = re * re + 4.0 * sg * sg * w * w;
-  const double b = exp(th[P_C0] + u * (th[P_C1] + u * (th[P_C2] + u * th[P_C3])));
-  const double mode = b / d, s = mode + n;
-  if (grad) {
-    const double dd_sg = 4.0 * re * sg + 8.0 * sg * w * w, dd_w0 = 4.0 * re * w0, ms = mode / s;
-    grad[P_SIGMA] = -ms / d * dd_sg;
-    grad[P_W0] = -ms / d * dd_w0;
-    grad[P_C0] = ms;
-    grad[P_C1] = ms * u;
-    grad[P_C2] = ms * u * u;
-    grad[P_C3] = ms * u * u * u;
-    grad[P_LN] = n / s;
-  }
-  return s;
+
+void hm_mode_estimate_use_reading(hm_mode_estimate *e, const hm_mode_reading *r) {
+  if (!e || !r) return;
+  e->valid = r->valid;
+  e->informative = r->informative;
+  e->frequency_hz = r->frequency_hz;
+  e->frequency_se_hz = r->frequency_se_hz;
+  e->decay_rate_1_s = r->decay_rate_1_s;
+  e->decay_rate_se_1_s = r->decay_rate_se_1_s;
+  e->damping_ratio = r->damping_ratio;
+  e->damping_ratio_se = r->damping_ratio_se;
+  e->peak_to_mean = r->peak_to_mean;
+  e->poles = r->poles;
+  e->second_frequency_hz = r->second_frequency_hz;
+  e->second_decay_rate_1_s = r->second_decay_rate_1_s;
+  e->two_pair_lr = r->two_pair_lr;
+  e->peak_core_z = r->peak_core_z;
+  e->iterations = r->iterations;
 }
 
-/* The negative Whittle log-likelihood over the band's nb bins at th and, when f is not NULL, the Fisher information
- * J'J in f and the score J'(I/S - 1) in g there: one pass, one exp and one log a bin. */
-static double evaluate(const hm_modal m, size_t nb, const double *th, double f[NP][NP], double *g) {
-  double l = 0.0;
-  const double noise = exp(th[P_LN]);
-  if (f) {
-    memset(f, 0, sizeof(double) * NP * NP);
-    memset(g, 0, sizeof(double) * NP);
+/* One window's geometry: its band bins k0..k1, bin spacing, length, the periodogram's reference frequency and the
+ * padding's factor nfft / n. */
+typedef struct {
+  size_t k0, k1;
+  double df, T, w_ref, padding;
+} window_geometry;
+
+/* The band's bins not marked in mask (NULL: all) into m->w, u, pgram, scaled to mean 1 (*scale the factor); their
+ * count. */
+static size_t load_bins(hm_modal m, const window_geometry *g, const unsigned char *mask, double *scale) {
+  size_t nb = 0;
+  double sum = 0.0;
+  for (size_t k = g->k0; k <= g->k1; ++k) {
+    if (mask && mask[k]) continue;
+    m->w[nb] = 2.0 * HM_PI * (double)k * g->df;
+    m->u[nb] = log(m->w[nb] / g->w_ref);
+    m->pgram[nb] = m->power[k];
+    sum += m->pgram[nb++];
   }
-  for (size_t k = 0; k < nb; ++k) {
-    double j[NP];
-    const double sk = spectrum(th, noise, m->w[k], m->u[k], f ? j : NULL), q = m->pgram[k] / sk;
-    l += log(sk) + q;
-    if (!f) continue;
-    for (int a = 0; a < NP; ++a) {
-      g[a] += j[a] * (q - 1.0);
-      for (int b = 0; b <= a; ++b) f[a][b] += j[a] * j[b];
-    }
-  }
-  if (f)
-    for (int a = 0; a < NP; ++a)
-      for (int b = a + 1; b < NP; ++b) f[a][b] = f[b][a];
-  return l;
+  *scale = nb ? sum / (double)nb : 0.0;
+  if (!(*scale > 0.0)) return 0;
+  for (size_t k = 0; k < nb; ++k) m->pgram[k] /= *scale;
+  return nb;
 }
 
-/* Cholesky solve of the NP x NP system a x = b (a overwritten); 0 if not positive definite. */
-static int chol_solve(double a[NP][NP], double *b) {
-  for (int j = 0; j < NP; ++j) {
-    double d = a[j][j];
-    for (int k = 0; k < j; ++k) d -= a[j][k] * a[j][k];
-    if (!(d > 0.0)) return 0;
-    a[j][j] = sqrt(d);
-    for (int i = j + 1; i < NP; ++i) {
-      double s = a[i][j];
-      for (int k = 0; k < j; ++k) s -= a[i][k] * a[j][k];
-      a[i][j] = s / a[j][j];
+/* The reading of a fit theta (poles pairs, Fisher information f): the least-damped pair is the mode. */
+static void reading_of(const hm_modal m, const window_geometry *g, const hm_whittle_data *d, const double *th,
+                       unsigned poles, const double f[NPM][NPM], hm_mode_reading *r) {
+  double var[NPM];
+  hm_whittle_variances(f, hm_whittle_np(poles), g->padding, var);
+  const int second = poles == 2 && fabs(th[HM_W_SIGMA2]) < fabs(th[HM_W_SIGMA]); /* the mode is the second pair */
+  const int is = second ? HM_W_SIGMA2 : HM_W_SIGMA, iw = second ? HM_W_W02 : HM_W_W0;
+  const double sg = -fabs(th[is]), w0 = fabs(th[iw]), mag = sqrt(sg * sg + w0 * w0);
+  r->poles = poles;
+  r->frequency_hz = w0 / (2.0 * HM_PI);
+  r->frequency_se_hz = sqrt(var[iw]) / (2.0 * HM_PI);
+  r->decay_rate_1_s = sg;
+  r->decay_rate_se_1_s = sqrt(var[is]);
+  r->damping_ratio = -sg / mag;
+  /* d zeta / d sigma = w0^2 / |s|^3 (w0's share of the error is second order for light damping) */
+  r->damping_ratio_se = r->decay_rate_se_1_s * w0 * w0 / (mag * mag * mag);
+  r->peak_to_mean = hm_whittle_peak(th, (unsigned)second, g->T, g->w_ref); /* the periodogram is scaled to mean 1 */
+  r->second_frequency_hz = poles == 2 ? fabs(th[second ? HM_W_W0 : HM_W_W02]) / (2.0 * HM_PI) : 0.0;
+  r->second_decay_rate_1_s = poles == 2 ? -fabs(th[second ? HM_W_SIGMA : HM_W_SIGMA2]) : 0.0;
+  /* the peak's core (within half its width a_e of w0): sum (I/S - 1) over its bins, standardised (a padded bin
+   * counts 1 / padding); a narrower resonance inside the pair's fitted peak leaves an excess there */
+  const double half = 0.5 * (-sg + HM_WHITTLE_LEAKAGE / g->T);
+  double sum = 0.0;
+  size_t n_core = 0;
+  for (size_t k = 0; k < d->n; ++k)
+    if (fabs(d->w[k] - w0) <= half) {
+      sum += d->pgram[k] / hm_whittle_spectrum(th, poles, g->T, d->w[k], d->u[k]) - 1.0;
+      ++n_core;
+    }
+  r->peak_core_z = n_core ? sum / sqrt((double)n_core * g->padding) : 0.0;
+  r->informative = isfinite(r->decay_rate_se_1_s) &&
+                   r->decay_rate_se_1_s <= HM_MODAL_INFORMATIVE_SE_1_S + HM_MODAL_INFORMATIVE_REL * fabs(sg);
+  const double margin_hz = 3.0 * r->frequency_se_hz + 2.0 * g->df;
+  r->valid = r->informative && isfinite(r->frequency_se_hz) && r->frequency_hz > m->cfg.band_low_hz + margin_hz &&
+             r->frequency_hz < m->cfg.band_high_hz - margin_hz && r->damping_ratio < 0.5 && r->peak_to_mean > 3.0;
+}
+
+/* An angular frequency [rad/s] inside the band. */
+static int in_band(const hm_modal m, double w) {
+  const double f = fabs(w) / (2.0 * HM_PI);
+  return f > m->cfg.band_low_hz && f < m->cfg.band_high_hz;
+}
+
+/* A two-pair fit th that tells a mode beside another resonance, against the one-pair fit th1: both pairs inside the
+ * band (a pair outside is the numerator's business), the less damped one inside the one pair's peak (within its
+ * half-width |sigma| of its frequency, or 2 / T: the resonance the one pair averaged) and that peak's top: at least
+ * half the spectrum at its frequency and above the other pair's peak. A second pair that fits a chance bump on a
+ * resonance's flank is less damped, but none of these. */
+static int two_pairs_tell(const hm_modal m, const window_geometry *g, const double *th, const double *th1) {
+  if (!in_band(m, th[HM_W_W0]) || !in_band(m, th[HM_W_W02])) return 0;
+  const unsigned ld = fabs(th[HM_W_SIGMA2]) < fabs(th[HM_W_SIGMA]) ? 1u : 0u;
+  const double w = fabs(th[ld ? HM_W_W02 : HM_W_W0]);
+  if (fabs(w - fabs(th1[HM_W_W0])) > fmax(fabs(th1[HM_W_SIGMA]), 2.0 * 2.0 * HM_PI / g->T)) return 0;
+  const double peak = hm_whittle_peak(th, ld, g->T, g->w_ref), other = hm_whittle_peak(th, 1u - ld, g->T, g->w_ref);
+  return peak >= 0.5 * hm_whittle_spectrum(th, 2, g->T, w, log(w / g->w_ref)) && peak >= other;
+}
+
+/* The best converged fit of `poles` pairs from the starts given (n_starts of them, each NPM values); 1 if any
+ * converged (th, obj, f set), 0 otherwise. *iters accumulates the steps. */
+static int best_of(const hm_whittle_data *d, unsigned poles, const double (*starts)[NPM], int n_starts,
+                   unsigned max_iter, double tol, double *th, double *obj, double f[NPM][NPM], unsigned *iters) {
+  int found = 0;
+  *obj = INFINITY;
+  for (int k = 0; k < n_starts; ++k) {
+    double t[NPM], o, fk[NPM][NPM];
+    unsigned it = 0;
+    memcpy(t, starts[k], sizeof t);
+    const int ok = hm_whittle_score(d, poles, t, tol, max_iter, &o, fk, &it);
+    *iters += it;
+    if (ok && o < *obj) {
+      memcpy(th, t, sizeof t);
+      memcpy(f, fk, sizeof fk);
+      *obj = o;
+      found = 1;
     }
   }
-  for (int i = 0; i < NP; ++i) {
-    double s = b[i];
-    for (int k = 0; k < i; ++k) s -= a[i][k] * b[k];
-    b[i] = s / a[i][i];
+  return found;
+}
+
+/* The best two-pair fit from the starts given (the choice needs the objective to HM_MODAL_TOL2 only); a start whose
+ * objective after HM_MODAL_SCREEN_ITER2 steps is not within half the choice's margin of the one pair's obj1 is
+ * given up (a second pair that far off is not there), the others get HM_MODAL_MAX_ITER2 steps in all. 1 if any
+ * converged (th, obj, f set). */
+static int fit_two_pairs(const hm_modal m, const hm_whittle_data *d, const window_geometry *g,
+                         const double (*starts)[NPM], int n_starts, double obj1, double *th, double *obj,
+                         double f[NPM][NPM], unsigned *iters) {
+  const double tol = fmax(m->cfg.tol, HM_MODAL_TOL2), reach = obj1 - 0.25 * HM_MODAL_TWO_PAIR_LR * g->padding;
+  const unsigned screen = HM_MODAL_SCREEN_ITER2 < m->cfg.max_iter ? HM_MODAL_SCREEN_ITER2 : m->cfg.max_iter;
+  const unsigned rest = m->cfg.max_iter > HM_MODAL_MAX_ITER2 ? HM_MODAL_MAX_ITER2 - screen : m->cfg.max_iter - screen;
+  int found = 0;
+  *obj = INFINITY;
+  for (int k = 0; k < n_starts; ++k) {
+    double t[NPM], o, fk[NPM][NPM];
+    unsigned it = 0;
+    memcpy(t, starts[k], sizeof t);
+    int ok = hm_whittle_score(d, 2, t, tol, screen, &o, fk, &it);
+    *iters += it;
+    if (!ok && o < reach && rest > 0) {
+      ok = hm_whittle_score(d, 2, t, tol, rest, &o, fk, &it);
+      *iters += it;
+    }
+    if (ok && o < *obj) {
+      memcpy(th, t, sizeof t);
+      memcpy(f, fk, sizeof fk);
+      *obj = o;
+      found = 1;
+    }
   }
-  for (int i = NP - 1; i >= 0; --i) {
-    double s = b[i];
-    for (int k = i + 1; k < NP; ++k) s -= a[k][i] * b[k];
-    b[i] = s / a[i][i];
+  return found;
+}
+
+/* Fit one reading over the nb bins loaded: one pair (from the warm start, else from two cold ones), two pairs (from
+ * the warm start and from the one pair split), the likelihood ratio chooses; the chosen theta in th and its pairs in
+ * *poles. 0 if not even one pair converged (ws forgotten). */
+static int fit_reading(hm_modal m, warm_start *ws, const window_geometry *g, size_t nb, hm_mode_reading *r,
+                       double *th, unsigned *poles) {
+  const hm_whittle_data d = {m->w, m->u, m->pgram, nb, g->T};
+  double starts[2][NPM], th1[NPM], f1[NPM][NPM], obj1;
+  unsigned iters = 0;
+  int found = 0;
+  if (ws->have1) { /* a converged warm start is enough, with its mode in the band (else it is lost: cold starts) */
+    memcpy(starts[0], ws->th1, sizeof starts[0]);
+    found = best_of(&d, 1, (const double(*)[NPM])starts, 1, m->cfg.max_iter, m->cfg.tol, th1, &obj1, f1, &iters) &&
+            in_band(m, th1[HM_W_W0]);
   }
+  if (!found) {
+    const size_t h = (size_t)fmax(1.0, round(0.1 / g->df)); /* 0.1 Hz half-width */
+    hm_whittle_cold_start(&d, h, -0.7, starts[0]);
+    hm_whittle_cold_start(&d, h, -4.0, starts[1]);
+    found = best_of(&d, 1, (const double(*)[NPM])starts, 2, m->cfg.max_iter, m->cfg.tol, th1, &obj1, f1, &iters);
+  }
+  ws->have1 = found;
+  if (!found) {
+    ws->have2 = 0;
+    return 0;
+  }
+  memcpy(ws->th1, th1, sizeof th1);
+  /* two pairs */
+  double th2[NPM], f2[NPM][NPM], obj2, starts2[3][NPM];
+  int n2 = 0;
+  if (ws->have2) memcpy(starts2[n2++], ws->th2, sizeof starts2[0]);
+  /* the one pair's splits every HM_MODAL_SPLIT_EVERY fits (from the first): the warm start follows a resonance once
+   * found, the splits find a new one */
+  if (++ws->since_split >= HM_MODAL_SPLIT_EVERY) {
+    hm_whittle_split_start(th1, g->T, 0.4, starts2[n2++]);
+    hm_whittle_split_start(th1, g->T, 0.15, starts2[n2++]);
+    ws->since_split = 0;
+  }
+  const int found2 = n2 > 0 && fit_two_pairs(m, &d, g, (const double(*)[NPM])starts2, n2, obj1, th2, &obj2, f2, &iters);
+  ws->have2 = found2 && in_band(m, th2[HM_W_W0]) && in_band(m, th2[HM_W_W02]);
+  if (found2) memcpy(ws->th2, th2, sizeof th2);
+  const double lr = found2 ? 2.0 * (obj1 - obj2) / g->padding : 0.0;
+  const int two = found2 && lr > HM_MODAL_TWO_PAIR_LR && two_pairs_tell(m, g, th2, th1);
+  *poles = two ? 2 : 1;
+  memcpy(th, two ? th2 : th1, sizeof(double) * NPM);
+  reading_of(m, g, &d, th, *poles, two ? (const double(*)[NPM])f2 : (const double(*)[NPM])f1, r);
+  r->two_pair_lr = lr;
+  r->iterations = iters;
   return 1;
 }
 
-/* Levenberg-damped Fisher scoring from th (updated in place); the final objective in *obj, its Fisher information in
- * fisher, steps in *iters. 1 if converged (relative objective change below tol on an accepted step), 0 otherwise.
- * A step that raises the objective by less than tol (relative) ends it too: th is at the optimum to the tolerance. */
-static int score(const hm_modal m, size_t nb, double *th, double *obj, unsigned *iters, double fisher[NP][NP]) {
-  double f[NP][NP], g[NP];
-  double l = evaluate(m, nb, th, f, g), mu = 1e-3;
-  int converged = 0;
-  for (unsigned it = 0; it < m->cfg.max_iter && !converged; ++it) {
-    int accepted = 0;
-    for (int tries = 0; tries < 30 && !accepted && !converged; ++tries) {
-      double a[NP][NP], step[NP], trial[NP], ft[NP][NP], gt[NP];
-      memcpy(a, f, sizeof a);
-      memcpy(step, g, sizeof step);
-      for (int i = 0; i < NP; ++i) a[i][i] += mu * f[i][i] + 1e-12;
-      if (!chol_solve(a, step)) {
-        mu *= 10.0;
-        continue;
-      }
-      for (int i = 0; i < NP; ++i) trial[i] = th[i] + step[i];
-      trial[P_LN] = fmax(trial[P_LN], -60.0); /* a floor far below any signal: the noise may be absent */
-      /* the first try is usually taken: its scoring system comes in the same pass; after a refusal only the
-       * objective, and the scoring system once a try is taken */
-      const double lt = evaluate(m, nb, trial, tries == 0 ? ft : NULL, gt);
-      if (isfinite(lt) && lt <= l) {
-        const double change = (l - lt) / (fabs(l) + 1.0);
-        if (tries > 0) evaluate(m, nb, trial, ft, gt);
-        memcpy(th, trial, sizeof trial);
-        memcpy(f, ft, sizeof f);
-        memcpy(g, gt, sizeof g);
-        l = lt;
-        mu = fmax(mu * 0.3, 1e-9);
-        *iters = it + 1;
-        accepted = 1;
-        converged = change < m->cfg.tol;
-        continue;
-      }
-      if (isfinite(lt) && (lt - l) / (fabs(l) + 1.0) < m->cfg.tol) { /* at the optimum to the tolerance: a step
-                                                                         that changes nothing but rounding */
-        *iters = it + 1;
-        converged = 1;
-        continue;
-      }
-      mu *= 10.0;
-      if (mu > 1e12) { /* no descent direction left: a stationary point */
-        *iters = it + 1;
-        converged = 1;
-      }
-    }
-  }
-  *obj = l;
-  memcpy(fisher, f, sizeof f);
-  return converged;
+/* A mode as narrow as a line (|sigma| within two standard errors of the a line's reading, which the window's
+ * leakage puts below 10 / T) and a line at f_hz on it: the line and the mode near its Hopf speed look alike in one
+ * window (modal.h). */
+static int narrow_on(const window_geometry *g, const hm_mode_reading *r, double f_hz) {
+  return fabs(r->decay_rate_1_s) <= 10.0 / g->T + 2.0 * r->decay_rate_se_1_s &&
+         fabs(f_hz - r->frequency_hz) <= 1.5 / g->T + 2.0 * r->frequency_se_hz;
 }
 
-/* A cold start: the smoothed periodogram's peak, a given decay rate, a flat background, a low noise floor. */
-static void cold_start(const hm_modal m, size_t nb, double sigma0, double *th) {
-  const size_t h = (size_t)fmax(1.0, round(0.1 / (m->fd / (double)m->nfft))); /* 0.1 Hz half-width */
-  double best = -1.0, lo = INFINITY;
-  size_t kbest = nb / 2;
-  for (size_t k = 0; k < nb; ++k) {
-    double s = 0.0;
-    size_t n = 0;
-    for (size_t j = k >= h ? k - h : 0; j <= k + h && j < nb; ++j, ++n) s += m->pgram[j];
-    s /= (double)n;
-    if (s > best) best = s, kbest = k;
-    if (s < lo) lo = s;
+/* Which of the lone candidates in the band are sinusoids (lines.h's harmonic F test at HM_MODAL_LINE_F or more): their indices in lr into idx; their count. */
+static unsigned sinusoids(const hm_modal m, const window_geometry *g, const hm_lines_result *lr, size_t n,
+                          unsigned *idx) {
+  unsigned count = 0;
+  for (unsigned j = 0; j < lr->n_lone; ++j) {
+    const size_t k = lr->lone_bin[j];
+    if (k < g->k0 || k > g->k1 || m->set_aside[k]) continue;
+    const double f = hm_lines_sinusoid_f(m->re, m->im, m->nfft / 2 + 1, k, n, m->nfft);
+    if (f >= HM_MODAL_LINE_F) idx[count++] = j;
   }
-  const double w0 = m->w[kbest];
-  th[P_SIGMA] = sigma0;
-  th[P_W0] = w0;
-  th[P_C0] = log(fmax(best - 0.5 * lo, 1e-300) * 4.0 * sigma0 * sigma0 * w0 * w0);
-  th[P_C1] = th[P_C2] = th[P_C3] = 0.0;
-  th[P_LN] = log(fmax(0.5 * lo, 1e-300));
+  return count;
+}
+
+/* Set line j of lr aside and list it in e. */
+static void set_line_aside(hm_modal m, const window_geometry *g, const hm_lines_result *lr, unsigned j, size_t n,
+                           hm_mode_estimate *e) {
+  hm_lines_mark(m->lines, lr->lone_hz[j], lr->lone_ratio[j], m->nfft / 2 + 1, g->df, g->T, m->set_aside);
+  if (e->lone_lines < HM_MODAL_MAX_LONE) {
+    e->lone_line_hz[e->lone_lines] = lr->lone_hz[j];
+    /* a sinusoid of amplitude A over n samples has |X| = A n / 2 at its bin */
+    e->lone_line_mps2[e->lone_lines++] = 2.0 * sqrt(m->power[lr->lone_bin[j]]) / (double)n;
+  }
+}
+
+/* The window's periodogram (m->power, every bin) from the newest n decimated samples, oldest first, without their
+ * mean, zero-padded. */
+static void periodogram(hm_modal m, size_t n) {
+  const size_t oldest = (m->head + m->n_win - n) % m->n_win;
+  double mean = 0.0;
+  for (size_t k = 0; k < n; ++k) mean += m->ring[(oldest + k) % m->n_win];
+  mean /= (double)n;
+  for (size_t k = 0; k < m->nfft; ++k) m->re[k] = k < n ? m->ring[(oldest + k) % m->n_win] - mean : 0.0;
+  hm_fft_real(m->re, m->im, m->nfft, m->cosw, m->sinw, m->nfft_max);
+  for (size_t k = 0; k <= m->nfft / 2; ++k) m->power[k] = m->re[k] * m->re[k] + m->im[k] * m->im[k];
+}
+
+/* The comb of lines (lines.h) into r's fields and m->excluded; the search's result in *lr. */
+static void find_comb(hm_modal m, size_t n, double df, double T, hm_lines_result *lr, hm_mode_estimate *r) {
+  const size_t nbins = m->nfft / 2 + 1;
+  if (hm_lines_find(m->lines, m->power, nbins, df, T, 2.5, 0.3 * m->fd, m->excluded, lr) != HM_OK) {
+    memset(lr, 0, sizeof *lr);
+    memset(m->excluded, 0, nbins);
+  }
+  if (!m->cfg.reject_lines) { /* reported, not left out */
+    memset(m->excluded, 0, nbins);
+    lr->n_lone = 0;
+  }
+  r->lines_found = lr->found;
+  r->line_fundamental_hz = lr->fundamental_hz;
+  r->line_harmonics = lr->harmonics;
+  r->line_strongest_hz = lr->strongest_hz;
+  r->line_strongest_mps2 = lr->found ? 2.0 * sqrt(m->power[lr->strongest_bin]) / (double)n : 0.0;
+  memcpy(m->set_aside, m->excluded, nbins);
 }
 
 hm_status hm_modal_fit(hm_modal m, double max_window_s, hm_mode_estimate *out) {
@@ -360,100 +501,58 @@ hm_status hm_modal_fit(hm_modal m, double max_window_s, hm_mode_estimate *out) {
     *out = r;
     return HM_OK;
   }
-  /* the newest n samples, oldest first, without their mean, zero-padded */
-  const size_t oldest = (m->head + m->n_win - n) % m->n_win;
-  double mean = 0.0;
-  for (size_t k = 0; k < n; ++k) mean += m->ring[(oldest + k) % m->n_win];
-  mean /= (double)n;
-  for (size_t k = 0; k < m->nfft; ++k) m->re[k] = k < n ? m->ring[(oldest + k) % m->n_win] - mean : 0.0;
-  hm_fft_real(m->re, m->im, m->nfft, m->cosw, m->sinw, m->nfft_max);
-  const double df = m->fd / (double)m->nfft, w_ref = 2.0 * HM_PI * 0.5 * (m->cfg.band_low_hz + m->cfg.band_high_hz);
-  /* a comb of lines (a periodic excitation of the track) over the decimated signal's band */
-  const size_t nbins = m->nfft / 2 + 1;
-  for (size_t k = 0; k < nbins; ++k) m->power[k] = m->re[k] * m->re[k] + m->im[k] * m->im[k];
+  periodogram(m, n);
+  window_geometry g;
+  g.df = m->fd / (double)m->nfft;
+  g.T = r.window_s;
+  g.w_ref = 2.0 * HM_PI * 0.5 * (m->cfg.band_low_hz + m->cfg.band_high_hz);
+  g.padding = (double)m->nfft / (double)n;
+  g.k0 = (size_t)ceil(m->cfg.band_low_hz / g.df);
+  g.k1 = (size_t)fmin(floor(m->cfg.band_high_hz / g.df), (double)(m->nfft / 2));
   hm_lines_result lr;
-  if (hm_lines_find(m->lines, m->power, nbins, df, r.window_s, 2.5, 0.3 * m->fd, m->excluded, &lr) != HM_OK)
-    memset(&lr, 0, sizeof lr);
-  const int drop = m->cfg.reject_lines && lr.found;
-  r.lines_found = lr.found;
-  r.line_fundamental_hz = lr.fundamental_hz;
-  r.line_harmonics = lr.harmonics;
-  r.line_strongest_hz = lr.strongest_hz;
-  /* a sinusoid of amplitude A over n samples has |X| = A n / 2 at its bin */
-  r.line_strongest_mps2 = lr.found ? 2.0 * sqrt(m->power[lr.strongest_bin]) / (double)n : 0.0;
-  /* the band's bins (less a comb's), the periodogram scaled to mean 1 (the fit is scale-free; it keeps exp() in
-   * range) */
-  size_t nb = 0, n_band = 0;
-  double scale = 0.0;
-  for (size_t k = (size_t)ceil(m->cfg.band_low_hz / df); (double)k * df <= m->cfg.band_high_hz && k <= m->nfft / 2; ++k) {
-    ++n_band;
-    if (drop && m->excluded[k]) continue;
-    m->w[nb] = 2.0 * HM_PI * (double)k * df;
-    m->u[nb] = log(m->w[nb] / w_ref);
-    m->pgram[nb] = m->re[k] * m->re[k] + m->im[k] * m->im[k];
-    scale += m->pgram[nb++];
-  }
-  r.band_excluded_fraction = n_band ? 1.0 - (double)nb / (double)n_band : 0.0;
-  scale /= (double)nb;
-  if (!(scale > 0.0) || nb < 4 * NP) {
+  find_comb(m, n, g.df, g.T, &lr, &r);
+  /* the window's reading, without the comb; then without the lone lines it does not explain */
+  double scale, th[NPM];
+  unsigned poles;
+  size_t nb = load_bins(m, &g, m->set_aside, &scale);
+  if (nb < 4 * HM_WHITTLE_NP2) {
     *out = r;
     return HM_OK;
   }
-  for (size_t k = 0; k < nb; ++k) m->pgram[k] /= scale;
-  /* warm start from the last fit, and cold starts at two decay rates; the best likelihood wins */
-  double best[NP], best_f[NP][NP], best_obj = INFINITY;
-  int found = 0;
-  unsigned iters = 0;
-  for (int start = m->have_theta ? 0 : 1; start < 3; ++start) {
-    double th[NP], obj, fisher[NP][NP];
-    unsigned it = 0;
-    if (start == 0) {
-      memcpy(th, m->theta, sizeof th);
-    } else {
-      cold_start(m, nb, start == 1 ? -0.7 : -4.0, th);
+  hm_mode_reading rd;
+  memset(&rd, 0, sizeof rd);
+  if (!fit_reading(m, &m->warm[0], &g, nb, &rd, th, &poles)) return HM_ENOCONV;
+  /* lone lines (sinusoids among the lone candidates): set aside, but for one the mode sits on while as narrow as a
+   * line, which is the narrow-peak question (modal.h) */
+  unsigned lines[HM_LINES_MAX_LONE];
+  const unsigned n_lines = sinusoids(m, &g, &lr, n, lines);
+  int narrow = -1;
+  for (unsigned i = 0; i < n_lines; ++i)
+    if (narrow < 0 && narrow_on(&g, &rd, lr.lone_hz[lines[i]])) narrow = (int)lines[i];
+  for (unsigned i = 0; i < n_lines; ++i)
+    if ((int)lines[i] != narrow) set_line_aside(m, &g, &lr, lines[i], n, &r);
+  if (n_lines > (narrow >= 0 ? 1u : 0u)) {
+    nb = load_bins(m, &g, m->set_aside, &scale);
+    if (nb < 4 * HM_WHITTLE_NP2 || !fit_reading(m, &m->warm[0], &g, nb, &rd, th, &poles)) {
+      *out = r;
+      return HM_OK;
     }
-    const int ok = score(m, nb, th, &obj, &it, fisher);
-    iters += it;
-    if (ok && obj < best_obj) {
-      memcpy(best, th, sizeof best);
-      memcpy(best_f, fisher, sizeof best_f);
-      best_obj = obj;
-      found = 1;
-    }
-    if (start == 0 && ok) break; /* a converged warm start is enough */
   }
-  if (!found) {
-    m->have_theta = 0;
-    return HM_ENOCONV;
+  size_t n_band = 0, n_out = 0;
+  for (size_t k = g.k0; k <= g.k1; ++k) ++n_band, n_out += m->set_aside[k] != 0;
+  r.band_excluded_fraction = n_band ? (double)n_out / (double)n_band : 0.0;
+  if (narrow >= 0) { /* the reading with that line left out too */
+    r.narrow_peak = 1;
+    r.narrow_peak_hz = lr.lone_hz[narrow];
+    r.narrow_peak_mps2 = 2.0 * sqrt(m->power[lr.lone_bin[narrow]]) / (double)n;
+    hm_lines_mark(m->lines, lr.lone_hz[narrow], lr.lone_ratio[narrow], m->nfft / 2 + 1, g.df, g.T, m->set_aside);
+    double th_l[NPM];
+    unsigned poles_l;
+    const size_t nb_l = load_bins(m, &g, m->set_aside, &scale);
+    if (nb_l < 4 * HM_WHITTLE_NP2 || !fit_reading(m, &m->warm[1], &g, nb_l, &r.line_reading, th_l, &poles_l))
+      memset(&r.line_reading, 0, sizeof r.line_reading);
   }
-  memcpy(m->theta, best, sizeof best);
-  m->have_theta = 1;
-  /* standard errors from Whittle's covariance (J'J)^-1, for the n independent ordinates of nfft padded ones */
-  double var[NP];
-  const double padding = (double)m->nfft / (double)n;
-  for (int i = 0; i < NP; ++i) {
-    double a[NP][NP], e[NP] = {0};
-    memcpy(a, best_f, sizeof a);
-    e[i] = 1.0;
-    var[i] = chol_solve(a, e) ? e[i] * padding : INFINITY;
-  }
-  const double sg = -fabs(best[P_SIGMA]), w0 = fabs(best[P_W0]), mag = sqrt(sg * sg + w0 * w0);
-  r.frequency_hz = w0 / (2.0 * HM_PI);
-  r.frequency_se_hz = sqrt(var[P_W0]) / (2.0 * HM_PI);
-  r.decay_rate_1_s = sg;
-  r.decay_rate_se_1_s = sqrt(var[P_SIGMA]);
-  r.damping_ratio = -sg / mag;
-  /* d zeta / d sigma = w0^2 / |s|^3 (w0's share of the error is second order for light damping) */
-  r.damping_ratio_se = r.decay_rate_se_1_s * w0 * w0 / (mag * mag * mag);
-  const double uw = log(w0 / w_ref);
-  const double peak = exp(best[P_C0] + best[P_C1] * uw + best[P_C2] * uw * uw + best[P_C3] * uw * uw * uw) /
-                      (4.0 * sg * sg * w0 * w0);
-  r.peak_to_mean = peak; /* the periodogram is scaled to mean 1 over the band */
-  r.iterations = iters;
-  const double margin_hz = 3.0 * r.frequency_se_hz + 2.0 * df;
-  r.valid = isfinite(r.decay_rate_se_1_s) && isfinite(r.frequency_se_hz) &&
-            r.frequency_hz > m->cfg.band_low_hz + margin_hz && r.frequency_hz < m->cfg.band_high_hz - margin_hz &&
-            r.damping_ratio < 0.5 && r.peak_to_mean > 3.0;
+  hm_mode_estimate_use_reading(&r, &rd);
   *out = r;
   return HM_OK;
 }

@@ -1,0 +1,247 @@
+/* The identification's spectral model, one or two pole pairs, and its Whittle fit by Fisher scoring (whittle.h). */
+#include "whittle.h"
+
+#include <math.h>
+#include <string.h>
+
+enum { NPM = HM_WHITTLE_MAX_NP };
+
+/* One pair's term P (whittle.h) and the derivatives of ln P with respect to sigma (= -a) and w0: the Lorentzian of
+ * width a_e = a + HM_WHITTLE_LEAKAGE / T over the pair's two poles, times a_e (the power form). */
+static double pair_term(double sg, double w0, double w, double T, double *dl_sg, double *dl_w0) {
+  const double ae = -sg + HM_WHITTLE_LEAKAGE / T, dl = w - w0, sm = w + w0;
+  const double qd = ae * ae + dl * dl, qs = ae * ae + sm * sm;
+  *dl_sg = -(1.0 / ae - 2.0 * ae / qd - 2.0 * ae / qs);
+  *dl_w0 = 2.0 * dl / qd - 2.0 * sm / qs;
+  return ae / (qd * qs);
+}
+
+/* S at one bin (noise = exp(th[ln N]), rho = exp(th[ln rho]) passed in: one exp per pass), its gradient of ln S in
+ * grad if not NULL. */
+static double spectrum(const double *th, unsigned poles, double T, double noise, double rho, double w, double u,
+                       double *grad) {
+  double a1, b1;
+  const double p1 = pair_term(th[HM_W_SIGMA], th[HM_W_W0], w, T, &a1, &b1);
+  const double b = exp(th[HM_W_C0] + u * (th[HM_W_C1] + u * (th[HM_W_C2] + u * th[HM_W_C3])));
+  const double m1 = b * p1;
+  double m2 = 0.0, a2 = 0.0, b2 = 0.0;
+  if (poles == 2) m2 = b * rho * pair_term(th[HM_W_SIGMA2], th[HM_W_W02], w, T, &a2, &b2);
+  const double s = m1 + m2 + noise;
+  if (grad) {
+    const double r1 = m1 / s, r2 = m2 / s, rb = r1 + r2;
+    grad[HM_W_SIGMA] = r1 * a1;
+    grad[HM_W_W0] = r1 * b1;
+    grad[HM_W_C0] = rb;
+    grad[HM_W_C1] = rb * u;
+    grad[HM_W_C2] = rb * u * u;
+    grad[HM_W_C3] = rb * u * u * u;
+    grad[HM_W_LN] = noise / s;
+    if (poles == 2) {
+      grad[HM_W_SIGMA2] = r2 * a2;
+      grad[HM_W_W02] = r2 * b2;
+      grad[HM_W_LNRHO] = r2;
+    }
+  }
+  return s;
+}
+
+/* The objective at th and, when f is not NULL, the Fisher information J'J in f and the score J'(I/S - 1) in g: one
+ * pass, one exp and one log a bin. */
+static double evaluate(const hm_whittle_data *d, unsigned poles, const double *th, double f[NPM][NPM], double *g) {
+  const unsigned np = hm_whittle_np(poles);
+  const double noise = exp(th[HM_W_LN]), rho = poles == 2 ? exp(th[HM_W_LNRHO]) : 0.0;
+  double l = 0.0;
+  if (f) {
+    memset(f, 0, sizeof(double) * NPM * NPM);
+    memset(g, 0, sizeof(double) * NPM);
+  }
+  for (size_t k = 0; k < d->n; ++k) {
+    double j[NPM];
+    const double sk = spectrum(th, poles, d->window_s, noise, rho, d->w[k], d->u[k], f ? j : NULL), q = d->pgram[k] / sk;
+    l += log(sk) + q;
+    if (!f) continue;
+    for (unsigned a = 0; a < np; ++a) {
+      g[a] += j[a] * (q - 1.0);
+      for (unsigned b = 0; b <= a; ++b) f[a][b] += j[a] * j[b];
+    }
+  }
+  if (f)
+    for (unsigned a = 0; a < np; ++a)
+      for (unsigned b = a + 1; b < np; ++b) f[a][b] = f[b][a];
+  return l;
+}
+
+double hm_whittle_spectrum(const double *th, unsigned poles, double window_s, double w, double u) {
+  return spectrum(th, poles, window_s, exp(th[HM_W_LN]), poles == 2 ? exp(th[HM_W_LNRHO]) : 0.0, w, u, NULL);
+}
+
+double hm_whittle_objective(const hm_whittle_data *d, unsigned poles, const double *theta) {
+  return evaluate(d, poles, theta, NULL, NULL);
+}
+
+/* Cholesky solve of the n x n system a x = b (a overwritten); 0 if not positive definite. */
+static int chol_solve(double a[NPM][NPM], unsigned n, double *b) {
+  for (unsigned j = 0; j < n; ++j) {
+    double s = a[j][j];
+    for (unsigned k = 0; k < j; ++k) s -= a[j][k] * a[j][k];
+    if (!(s > 0.0)) return 0;
+    a[j][j] = sqrt(s);
+    for (unsigned i = j + 1; i < n; ++i) {
+      double t = a[i][j];
+      for (unsigned k = 0; k < j; ++k) t -= a[i][k] * a[j][k];
+      a[i][j] = t / a[j][j];
+    }
+  }
+  for (unsigned i = 0; i < n; ++i) {
+    double s = b[i];
+    for (unsigned k = 0; k < i; ++k) s -= a[i][k] * b[k];
+    b[i] = s / a[i][i];
+  }
+  for (unsigned i = n; i-- > 0;) {
+    double s = b[i];
+    for (unsigned k = i + 1; k < n; ++k) s -= a[k][i] * b[k];
+    b[i] = s / a[i][i];
+  }
+  return 1;
+}
+
+void hm_whittle_variances(const double fisher[NPM][NPM], unsigned np, double scale, double *var) {
+  for (unsigned i = 0; i < np; ++i) {
+    double a[NPM][NPM], e[NPM] = {0};
+    memcpy(a, fisher, sizeof a);
+    e[i] = 1.0;
+    var[i] = chol_solve(a, np, e) ? e[i] * scale : INFINITY;
+  }
+}
+
+/* Decay rates at most 0 (a stationary spectrum; 0 is a line's), and floors far below any signal: the noise, or the
+ * second pair, may be absent. */
+static void clamp(double *th, unsigned poles) {
+  th[HM_W_SIGMA] = fmin(th[HM_W_SIGMA], 0.0);
+  th[HM_W_LN] = fmax(th[HM_W_LN], -60.0);
+  if (poles == 2) {
+    th[HM_W_SIGMA2] = fmin(th[HM_W_SIGMA2], 0.0);
+    th[HM_W_LNRHO] = fmax(th[HM_W_LNRHO], -40.0);
+  }
+}
+
+/* The damped scoring step (f + mu diag f)^-1 g into st; a decay rate at its bound 0 that the step would raise is held
+ * there (the step solved without it: an active set), so that a line's fit converges on the bound. 0 if singular. */
+static int damped_step(const double f[NPM][NPM], const double *g, unsigned np, double mu, const double *th,
+                       unsigned poles, double *st) {
+  int held[NPM] = {0};
+  for (int pass = 0; pass < 2; ++pass) {
+    double a[NPM][NPM];
+    memcpy(a, f, sizeof a);
+    memcpy(st, g, sizeof(double) * NPM);
+    for (unsigned i = 0; i < np; ++i) {
+      a[i][i] += mu * f[i][i] + 1e-12;
+      if (!held[i]) continue;
+      for (unsigned j = 0; j < np; ++j) a[i][j] = a[j][i] = 0.0;
+      a[i][i] = 1.0;
+      st[i] = 0.0;
+    }
+    if (!chol_solve(a, np, st)) return 0;
+    int again = 0;
+    const unsigned sig[2] = {HM_W_SIGMA, HM_W_SIGMA2};
+    for (unsigned p = 0; p < poles; ++p)
+      if (!held[sig[p]] && th[sig[p]] >= 0.0 && st[sig[p]] > 0.0) held[sig[p]] = again = 1;
+    if (!again) return 1;
+  }
+  return 1;
+}
+
+/* One Levenberg-damped scoring step from th (objective l, information f, score g); 1 when a step was taken (th, l,
+ * f, g updated; *change its relative decrease), 0 at a stationary point (no descent left, or only rounding). */
+static int step(const hm_whittle_data *d, unsigned poles, double tol, double *th, double *l, double f[NPM][NPM],
+                double *g, double *mu, double *change) {
+  const unsigned np = hm_whittle_np(poles);
+  for (int tries = 0; tries < 30; ++tries) {
+    double st[NPM], trial[NPM], ft[NPM][NPM], gt[NPM];
+    if (!damped_step(f, g, np, *mu, th, poles, st)) {
+      *mu *= 10.0;
+      continue;
+    }
+    memcpy(trial, th, sizeof trial);
+    for (unsigned i = 0; i < np; ++i) trial[i] += st[i];
+    clamp(trial, poles);
+    /* the first try is usually taken: its scoring system comes in the same pass; after a refusal only the
+     * objective, and the scoring system once a try is taken */
+    const double lt = evaluate(d, poles, trial, tries == 0 ? ft : NULL, gt);
+    if (isfinite(lt) && lt <= *l) {
+      *change = (*l - lt) / (fabs(*l) + 1.0);
+      if (tries > 0) evaluate(d, poles, trial, ft, gt);
+      memcpy(th, trial, sizeof trial);
+      memcpy(f, ft, sizeof ft);
+      memcpy(g, gt, sizeof gt);
+      *l = lt;
+      *mu = fmax(*mu * 0.3, 1e-9);
+      return 1;
+    }
+    if (isfinite(lt) && (lt - *l) / (fabs(*l) + 1.0) < tol) return 0; /* at the optimum to the tolerance */
+    *mu *= 10.0;
+    if (*mu > 1e12) return 0; /* no descent direction left */
+  }
+  return 0;
+}
+
+int hm_whittle_score(const hm_whittle_data *d, unsigned poles, double *th, double tol, unsigned max_iter,
+                     double *obj, double fisher[NPM][NPM], unsigned *iters) {
+  double f[NPM][NPM], g[NPM], mu = 1e-3, change = 0.0;
+  double l = evaluate(d, poles, th, f, g);
+  int converged = 0;
+  unsigned it = 0;
+  while (it < max_iter && !converged) {
+    ++it;
+    if (!step(d, poles, tol, th, &l, f, g, &mu, &change)) converged = 1;
+    else converged = change < tol;
+  }
+  *iters = it;
+  *obj = l;
+  memcpy(fisher, f, sizeof f);
+  return converged && isfinite(l);
+}
+
+/* A pair's term at its own frequency (the peak), Re F(a) / (a^2 + 4 w0^2). */
+static double pair_peak(double sg, double w0, double T) {
+  double dummy_a, dummy_b;
+  return pair_term(sg, w0, w0, T, &dummy_a, &dummy_b);
+}
+
+void hm_whittle_cold_start(const hm_whittle_data *d, size_t h, double sigma0, double *th) {
+  double best = -1.0, lo = INFINITY;
+  size_t kbest = d->n / 2;
+  for (size_t k = 0; k < d->n; ++k) {
+    double s = 0.0;
+    size_t n = 0;
+    for (size_t j = k >= h ? k - h : 0; j <= k + h && j < d->n; ++j, ++n) s += d->pgram[j];
+    s /= (double)n;
+    if (s > best) best = s, kbest = k;
+    if (s < lo) lo = s;
+  }
+  const double w0 = d->w[kbest];
+  memset(th, 0, sizeof(double) * NPM);
+  th[HM_W_SIGMA] = -fabs(sigma0);
+  th[HM_W_W0] = w0;
+  th[HM_W_C0] = log(fmax(best - 0.5 * lo, 1e-300) / pair_peak(th[HM_W_SIGMA], w0, d->window_s));
+  th[HM_W_LN] = log(fmax(0.5 * lo, 1e-300));
+}
+
+void hm_whittle_split_start(const double *th1, double window_s, double narrow, double *th) {
+  memcpy(th, th1, sizeof(double) * HM_WHITTLE_NP1);
+  const double sg = -fabs(th1[HM_W_SIGMA]), w0 = fabs(th1[HM_W_W0]), sa = narrow * sg, sb = sg / narrow - 2.0;
+  /* at the frequency, the narrow pair 70% of the single pair's peak, the broad one 30% */
+  const double peak = exp(th1[HM_W_C0]) * pair_peak(sg, w0, window_s);
+  th[HM_W_SIGMA] = sa;
+  th[HM_W_C0] = log(0.7 * peak / pair_peak(sa, w0, window_s));
+  th[HM_W_SIGMA2] = sb;
+  th[HM_W_W02] = w0;
+  th[HM_W_LNRHO] = log(0.3 * peak / (exp(th[HM_W_C0]) * pair_peak(sb, w0, window_s)));
+}
+
+double hm_whittle_peak(const double *th, unsigned pair, double window_s, double w_ref) {
+  const double sg = pair ? th[HM_W_SIGMA2] : th[HM_W_SIGMA], w0 = fabs(pair ? th[HM_W_W02] : th[HM_W_W0]);
+  const double u = log(w0 / w_ref);
+  const double b = exp(th[HM_W_C0] + u * (th[HM_W_C1] + u * (th[HM_W_C2] + u * th[HM_W_C3])));
+  return (pair ? exp(th[HM_W_LNRHO]) : 1.0) * b * pair_peak(sg, w0, window_s);
+}

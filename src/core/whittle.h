@@ -1,0 +1,71 @@
+/*
+ * Private: the spectral model of the hunting-mode identification and its Whittle fit (modal.h says what it is for).
+ *
+ * Over the band's bins (angular frequency w_k, u_k = ln(w_k / w_ref), periodogram I_k of a window of T seconds) the
+ * model is one or two lightly damped pole pairs over a smooth numerator, plus white sensor noise:
+ *     S(w) = B(u) [ P(s1, w) + rho P(s2, w) ] + N,   B(u) = exp(c0 + c1 u + c2 u^2 + c3 u^3),
+ * where a pair s = sigma + i w0 (a = -sigma >= 0) contributes, approximately, what its spectrum a / d(s, w), d =
+ * |(iw - s)(iw - conj s)|^2, gives in the periodogram of a window of T seconds:
+ *     P(s, w) = a_e / ((a_e^2 + (w - w0)^2)(a_e^2 + (w + w0)^2)),   a_e = a + HM_WHITTLE_LEAKAGE / T,
+ * the Lorentzian smoothed by the window (a rectangular window's Fejer kernel has the area of a Lorentzian of any
+ * width and the peak T / 2 of one of width 2 / T; Lorentzians convolved add their widths). For a T >> 1 this is the
+ * rational spectrum a / d; for a T ~ 1 and below the peak keeps the window's width and height, so a mode near its
+ * Hopf speed and a line (a = 0: a sinusoid of random phase) are points of one regular model and sigma's standard
+ * error stays finite there (a Lorentzian alone narrows onto one bin as sigma -> 0 and its error diverges; the exact
+ * kernel, with its nulls, makes the likelihood in w0 as rough as the bins are wide). The factor a_e makes B the
+ * pair's power, whatever its damping. The parameters are theta = (sigma1, w01, c0, c1, c2, c3, ln N) for one pair
+ * and (..., sigma2, w02, ln rho) for two (rho = 0: one pair); sigma <= 0. The second pair holds a resonance the
+ * numerator cannot: a broad mode of the installation or the vehicle (a bogie frame's, 1-3 Hz wide) beside the
+ * hunting mode, which a single pair would average with it.
+ * Whittle's negative log-likelihood  L = sum_k ln S_k + I_k / S_k  is minimised by Levenberg-damped Fisher scoring
+ * (J = d ln S / d theta, step (J'J + mu diag)^-1 J'(I/S - 1)); its Fisher information J'J is returned for the
+ * standard errors (the caller scales them for a zero-padded periodogram).
+ */
+#ifndef HUNTING_MONITOR_WHITTLE_H
+#define HUNTING_MONITOR_WHITTLE_H
+
+#include <stddef.h>
+
+/* The window's leakage as a width [1/s] times T (above). */
+#define HM_WHITTLE_LEAKAGE 2.0
+
+enum { HM_WHITTLE_NP1 = 7, HM_WHITTLE_NP2 = 10, HM_WHITTLE_MAX_NP = 10 };
+enum { HM_W_SIGMA, HM_W_W0, HM_W_C0, HM_W_C1, HM_W_C2, HM_W_C3, HM_W_LN, HM_W_SIGMA2, HM_W_W02, HM_W_LNRHO };
+
+typedef struct {
+  const double *w, *u, *pgram; /* the bins: angular frequency [rad/s], ln(w / w_ref), periodogram (scaled) */
+  size_t n;
+  double window_s;             /* the data's length T [s] (the leakage's) */
+} hm_whittle_data;
+
+/* The number of parameters of a model of `poles` pairs (1 or 2). */
+static inline unsigned hm_whittle_np(unsigned poles) { return poles == 2 ? HM_WHITTLE_NP2 : HM_WHITTLE_NP1; }
+
+/* S(w) of theta at one angular frequency w [rad/s] (u = ln(w / w_ref)). */
+double hm_whittle_spectrum(const double *theta, unsigned poles, double window_s, double w, double u);
+
+/* The negative log-likelihood of theta over d's bins. */
+double hm_whittle_objective(const hm_whittle_data *d, unsigned poles, const double *theta);
+
+/* Minimise from theta (updated in place) by at most max_iter scoring steps; converged when an accepted step changes
+ * the objective by less than tol (relative) or no step can lower it. The objective in *obj, the Fisher information in
+ * fisher (np x np, row-major with stride HM_WHITTLE_MAX_NP), the steps in *iters. 1 if converged, else 0. */
+int hm_whittle_score(const hm_whittle_data *d, unsigned poles, double *theta, double tol, unsigned max_iter,
+                     double *obj, double fisher[HM_WHITTLE_MAX_NP][HM_WHITTLE_MAX_NP], unsigned *iters);
+
+/* The covariance's diagonal (the inverse of the np x np Fisher information), each times scale; INFINITY where it is
+ * singular. */
+void hm_whittle_variances(const double fisher[HM_WHITTLE_MAX_NP][HM_WHITTLE_MAX_NP], unsigned np, double scale,
+                          double *var);
+
+/* A one-pair start: the peak of the periodogram smoothed over +-halfwidth bins, decay rate sigma0, flat numerator. */
+void hm_whittle_cold_start(const hm_whittle_data *d, size_t halfwidth_bins, double sigma0, double *theta);
+
+/* A two-pair start from a one-pair fit th1: at its frequency, a narrower pair (narrow sigma, 0 < narrow < 1) holding
+ * 70% of its peak and a broader one (sigma / narrow - 2 1/s) the rest. */
+void hm_whittle_split_start(const double *th1, double window_s, double narrow, double *theta2);
+
+/* Pair k's (0 or 1) spectral peak B(u0) P(s, w0) in the periodogram's units. */
+double hm_whittle_peak(const double *theta, unsigned pair, double window_s, double w_ref);
+
+#endif
