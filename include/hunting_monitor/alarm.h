@@ -11,13 +11,18 @@
  *    worn to, [conicity_prior_low, conicity_prior_high] (0: the fallback -+ HM_ALARM_PRIOR_HALFWIDTH): the interval is
  *    the closed-form Hopf speeds at the range's ends (widened to hold the table's value at the fallback), never the
  *    table's interpolation error alone;
- *  - an estimate too uncertain to be used alone, or one of a vehicle that does not behave like its model
- *    (model_mismatch), is not replaced by the narrower prior: the level uses the more cautious of the two (the lower
- *    point, and the lower of each end);
- *  - the model-free interval (margin.h), when valid, bounds the level as well: its lower end with model_mismatch
- *    or from HM_ALARM_FREE_MIN_WINDOWS windows on (a regression through two has no residual to check it: from 50 s
- *    at 380 and 420 km/h its lower end lay 440-445 km/h on four runs of a vehicle whose Hopf speed is 473.8), its
- *    upper end with model_mismatch (the lower of each end).
+ *  - an estimate too uncertain to be used alone, outside the prior's range by more than its error (margin.h's
+ *    outside_prior: WATCH, HM_REASON_OUTSIDE_PRIOR), or of a conicity change not yet confirmed by a second window, is
+ *    not used alone: the level uses the more cautious of it and the prior (the lower point, and the lower of each
+ *    end), so an estimate can lower the interval (hollow-worn wheels do reach 0.3-0.5) but never raise it above the
+ *    prior's (a precise 0.08 would have put it at 657-742 km/h);
+ *  - the model-based interval is not used at all when the vehicle does not behave like its model (model_mismatch)
+ *    or the accelerometer is not on an axle box (hm_alarm_set_measurement_point): the prior, bounded by the
+ *    model-free interval;
+ *  - the model-free interval (margin.h), when valid, bounds the level as well: its lower end with model_mismatch, a
+ *    sensor off the axle box, or from HM_ALARM_FREE_MIN_WINDOWS windows on (a regression through two has no residual
+ *    to check it: from 50 s at 380 and 420 km/h its lower end lay 440-445 km/h on four runs of a vehicle whose Hopf
+ *    speed is 473.8), its upper end with model_mismatch or a sensor off the axle box (the lower of each end).
  * The table gives, at the conicity in use and the current speed, the lowest speed with a cycle, the unstable cycle
  * bounding the basin of the stable origin (the edge) and the stable cycle beyond it. Where the origin is unstable at
  * the conicity in use but the speed is still inside the Hopf interval, the edge is taken at the interval's
@@ -34,8 +39,10 @@
  *            the edge.
  *            Do not accelerate; reduce speed by the margin.
  *   WATCH    the speed at or above watch_from_kmh (the same with watch_speed_margin_kmh), or the vehicle not behaving like its
- *            model (the model-based and model-free Hopf speeds disagree), or the sensor at another rate than
- *            configured, or partly blind (more than blind_fraction of the last 10 s of samples lost, estimator.h).
+ *            model (the model-based and model-free Hopf speeds disagree), or an identified conicity outside the
+ *            prior's range, or a narrow peak that may be a line or the mode at its Hopf speed (margin.h), or the
+ *            sensor at another rate than configured, or partly blind (more than blind_fraction of the last 10 s of
+ *            samples lost, estimator.h).
  *            No action; have the wheels' conicity or the sensor checked at the next stop.
  *   OK       normal running. The bistable band (a large disturbance could start flange-contact hunting above the
  *            lowest cycle speed, docs/MODEL.md section 7) is stated in the status fields, not as a level: on good track
@@ -113,7 +120,11 @@ typedef enum {
   HM_REASON_RATE_MISMATCH = 13,     /* WATCH: the sensor delivers another rate than configured */
   HM_REASON_BAD_SAMPLE_RATE = 14,   /* NO_DATA: a sample rate the filters cannot be designed for */
   HM_REASON_DISPLACEMENT_CRITERION = 15, /* ALARM: the displacement amplitude at or above its limit (any frequency) */
-  HM_REASON_PARTLY_BLIND = 16       /* WATCH: more than blind_fraction of the samples of the last 10 s were lost */
+  HM_REASON_PARTLY_BLIND = 16,      /* WATCH: more than blind_fraction of the samples of the last 10 s were lost */
+  HM_REASON_OUTSIDE_PRIOR = 17,     /* WATCH: the identified conicity lies outside the prior's range by more than its
+                                       error (margin.h) */
+  HM_REASON_NARROW_PEAK = 18        /* WATCH: a narrow peak at the hunting frequency that may be a line or the mode at
+                                       its Hopf speed (margin.h) within the last HM_ALARM_NARROW_HOLD_S */
 } hm_reason;
 
 const char *hm_level_name(hm_level level);   /* "NO_DATA", "OK", ... */
@@ -160,6 +171,8 @@ typedef struct {
 #define HM_ALARM_SE_HYSTERESIS 1.25
 /* The model-free interval's lower end counts for the level from this many windows on (and with model_mismatch). */
 #define HM_ALARM_FREE_MIN_WINDOWS 3u
+/* WATCH for an ambiguous narrow peak (HM_REASON_NARROW_PEAK) while the latest such window ended this recently [s]. */
+#define HM_ALARM_NARROW_HOLD_S 60.0
 
 /* Defaults: 0.5, 10 km/h, 30 km/h, 3 km/h, 0.1, 3 s, estimate used up to a standard error of 0.01, fallback 0
  * (the vehicle's), prior 0 / 0 (the fallback -+ 0.03), release after 10 s below half the displacement limit. */
@@ -182,6 +195,14 @@ typedef struct {
   double anticipation_kmh;          /* added to the speed for those thresholds below an identified interval: the
                                        sustained acceleration times HM_ALARM_RAISE_LOOKAHEAD_S (0 when not accelerating
                                        or on the prior) */
+  int model_interval_used;          /* the model-based interval entered the level: an estimate (alone or with the prior),
+                                       from an axle-box sensor (measurement point wheelset), the vehicle behaving like
+                                       its model (no model_mismatch) */
+  double warn_risk;                 /* with an identified interval (conicity_from_estimate): the probability that the
+                                       Hopf speed lies below warn_from_kmh, Phi(-(point - warn_from) / se), the interval
+                                       read as normal with se = its lower half-width / interval_z (one standard error:
+                                       0.159); NAN otherwise */
+  int narrow_peak_ambiguous;        /* a window of the last HM_ALARM_NARROW_HOLD_S had an ambiguous narrow peak */
   int hopf_low_from_hunting;        /* hopf_low_kmh is the lowest speed at which the held ALARM's oscillation met a
                                        criterion (below the interval the estimate or prior gave) */
   double edge_used_m;               /* the edge amplitude the amplitude rules use (0: none) */
@@ -207,6 +228,13 @@ void hm_alarm_reset(hm_alarm alarm);
  * reason in why, and nothing changes); the fallback conicity 0 becomes veh's lambda(0). */
 hm_status hm_alarm_set_config(hm_alarm alarm, const hm_alarm_config *cfg, const hm_vehicle *veh, char *why,
                               size_t why_len);
+/* Where the accelerometer is (estimator.h; HM_POINT_WHEELSET by default): the model-based interval counts for the
+ * level only from an axle box; from a bogie frame the model-free one carries it with the prior (a wheelset model does
+ * not hold the frame's modes: a frame sensor read -6.3 1/s where the bogie's least damped mode was -0.98, issue #26). */
+void hm_alarm_set_measurement_point(hm_alarm alarm, hm_measurement_point point);
+/* The prior's conicity range in use (resolved for the vehicle: alarm_config's conicity_prior_low/high or the fallback
+ * -+ HM_ALARM_PRIOR_HALFWIDTH). */
+void hm_alarm_prior(const hm_alarm alarm, double *conicity_low, double *conicity_high);
 /* Look boundaries up in this table from the next update on (borrowed, as at create; the level is kept). */
 void hm_alarm_set_table(hm_alarm alarm, const hm_table table);
 

@@ -13,8 +13,9 @@
  * changes).
  * Change: a new window (committed or provisional) whose conicity differs from the mean of those held by more than
  * change_z of their combined standard errors means the conicity changed (a worn section of rail, other wheels after a
- * coupling): the windows held are dropped, the new one too (it may straddle the change), and the estimate starts
- * again from the next window (n_changes, last_change_s). Windows that disagree less still widen the interval: the
+ * coupling): the windows held are dropped and the new one is kept (the evidence of the change; committed, also when
+ * it was the provisional one), so that the estimate continues from it (n_changes, last_change_s,
+ * windows_since_change; the alarm takes the more cautious of it and the prior until a second window agrees). Windows that disagree less still widen the interval: the
  * conicity's standard error is scaled by the Birge ratio sqrt(chi2 / (n - 1)) of the windows held when it exceeds 1.
  *
  * (a) Model-based. Each window's (decay rate, frequency, speed) is inverted jointly for the equivalent conicity
@@ -38,6 +39,14 @@
  *     windows' speeds and the curve at the zero. Valid with two or more windows spanning min_speed_span_kmh, a
  *     slope significantly negative (Fieller's interval bounded), and the zero no more than max_extrapolation_kmh
  *     above the highest speed seen. A proportional bias of the decay rates does not move this zero.
+ * A narrow peak (modal.h: the mode sits on a line-like peak, so a line and the mode near its Hopf speed look alike in
+ * the window) is the hunting mode when the model produces it at this speed (its decay rate and frequency together)
+ * and its conicity is supported: within change_z combined standard errors of the windows held or, without any, within
+ * the prior's range (hm_margin_set_prior) to interval_z of its error. Else it is a line when the reading without it is
+ * a mode of its own (the model cannot produce the narrow one, or a second resonance was fitted beside it, or that
+ * mode is over 1 Hz away) and supported the same way; else the window is not used (HM_WINDOW_AMBIGUOUS; the alarm
+ * says so). A line at 14 Hz at 400 km/h reads as the mode at its Hopf speed with a conicity of 0.22 where the prior
+ * says 0.11-0.17: set aside when the mode beside it is found, ambiguous otherwise.
  * model_mismatch, the vehicle not behaving like its model: both valid with disjoint intervals, or two or more
  * misfit windows (a mode the model cannot produce at that speed, e.g. a bogie mode at 8 Hz) within memory_s.
  */
@@ -75,6 +84,17 @@ typedef struct {
 void hm_margin_config_default(hm_margin_config *cfg);
 hm_status hm_margin_config_validate(const hm_margin_config *cfg, char *why, size_t why_len);
 
+/* What a window's narrow peak (modal.h: a line and the mode near its Hopf speed look alike) was taken for. */
+typedef enum {
+  HM_NARROW_NONE = 0,      /* the window had none */
+  HM_NARROW_MODE = 1,      /* the hunting mode near its Hopf speed: the model produces it and its conicity is supported */
+  HM_NARROW_LINE = 2,      /* a line: the reading without it was used (or there was no mode beside it) */
+  HM_NARROW_AMBIGUOUS = 3  /* either: the window was not used (HM_WINDOW_AMBIGUOUS) */
+} hm_narrow_verdict;
+
+/* A short English phrase for a narrow-peak verdict; never NULL. */
+const char *hm_narrow_verdict_text(hm_narrow_verdict verdict);
+
 typedef struct {
   unsigned n_windows;               /* windows in memory */
   int conicity_valid;               /* (a) */
@@ -90,6 +110,13 @@ typedef struct {
   unsigned n_misfits;               /* misfit windows within memory_s */
   unsigned long n_changes;          /* changes of the conicity detected (the windows dropped each time) */
   double last_change_s;             /* when the last one was (0 if none) */
+  unsigned windows_since_change;    /* windows held since it (the one that showed it included; n_windows if none) */
+  int outside_prior;                /* the conicity's interval (-+ interval_z standard errors) lies wholly above (+1:
+                                       the Hopf speed below the prior's range) or below (-1) the prior's range
+                                       (hm_margin_set_prior), else 0 */
+  hm_narrow_verdict narrow;         /* the latest window's narrow peak, its frequency [Hz] and the window's end [s] */
+  double narrow_peak_hz, narrow_at_s;
+  double ambiguous_at_s;            /* the end of the latest window not used for an ambiguous narrow peak (0: none) */
   int model_mismatch;               /* (a) and (b) valid with disjoint intervals, or two or more misfits */
 } hm_margin_estimate;
 
@@ -102,8 +129,10 @@ typedef enum {
   HM_WINDOW_NO_INVERSION = 5,
   HM_WINDOW_MISFIT = 6,     /* the model explains its decay rate and frequency together no better than chi2 limit */
   HM_WINDOW_CHANGE = 7,     /* its conicity disagrees with the windows held: they were dropped, and so was it */
-  HM_WINDOW_NONLINEAR = 8   /* a criterion was met during it: hunting or its onset is not the linear mode
+  HM_WINDOW_NONLINEAR = 8,  /* a criterion was met during it: hunting or its onset is not the linear mode
                                (monitor.h) */
+  HM_WINDOW_AMBIGUOUS = 9   /* its narrow peak may be a line or the mode at its Hopf speed, and neither reading is
+                               supported (below): not used */
 } hm_window_verdict;
 
 /* A short English sentence for a verdict; never NULL. */
@@ -116,6 +145,12 @@ hm_status hm_margin_create(const hm_margin_config *cfg, const hm_vehicle *veh, h
                            size_t why_len);
 void hm_margin_destroy(hm_margin m);
 void hm_margin_reset(hm_margin m);
+/* The range of conicities the wheels may have worn to (the alarm's prior, alarm.h): a narrow peak's conicity is
+ * supported by it when no window is held, and an estimate outside it is reported (outside_prior). Invalid values
+ * (non-finite, not 0 < low < high) remove it. */
+void hm_margin_set_prior(hm_margin m, double conicity_low, double conicity_high);
+/* What the latest window offered (committed or provisional) took its narrow peak for. */
+hm_narrow_verdict hm_margin_last_narrow(const hm_margin m);
 
 /* Offer a window ending at t_end_s [s] with its mean speed and speed range [km/h]; the verdict says whether it was
  * used. HM_EINVAL for NULL or non-finite arguments. */

@@ -141,8 +141,9 @@ typedef struct {
  * more parameters beyond its 0.03% point: a lone pair with a chance second pair almost never). */
 #define HM_MODAL_TWO_PAIR_LR 12.0
 
-/* The reading as the window's estimate (its fields copied; the window's lines kept). */
+/* The reading as the window's estimate (its fields copied; the window's lines kept), and the estimate's own reading. */
 void hm_mode_estimate_use_reading(hm_mode_estimate *e, const hm_mode_reading *r);
+void hm_mode_estimate_reading(const hm_mode_estimate *e, hm_mode_reading *r);
 
 typedef struct hm_modal_s *hm_modal;
 

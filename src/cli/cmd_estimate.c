@@ -6,6 +6,7 @@
 
 #include "cli.h"
 #include "hunting_monitor/config.h"
+#include "hunting_monitor/linear.h"
 #include "hunting_monitor/monitor.h"
 #include "hunting_monitor/tables.h"
 #include "hunting_monitor/threads.h"
@@ -74,6 +75,9 @@ static void write_line(const hm_monitor_status *st, double t) {
   jw_number(&w, "damping_ratio_se", md->valid ? md->damping_ratio_se : NAN);
   jw_number(&w, "mode_speed_kmh", md->valid ? st->mode_speed_kmh : NAN);
   jw_number(&w, "mode_speed_spread_kmh", md->valid && st->mode_speed_spread_kmh >= 0.0 ? st->mode_speed_spread_kmh : NAN);
+  jw_int(&w, "mode_pole_pairs", (long)(md->valid ? md->poles : 0));
+  jw_number(&w, "mode_second_frequency_hz", md->valid && md->poles == 2 ? md->second_frequency_hz : NAN);
+  jw_number(&w, "mode_second_decay_rate_1_s", md->valid && md->poles == 2 ? md->second_decay_rate_1_s : NAN);
   jw_int(&w, "mode_window_verdict", (long)st->mode_verdict);
   jw_string(&w, "mode_window_verdict_text", hm_window_verdict_text(st->mode_verdict));
   /* a periodic excitation of the track found in the latest window (its bins left out of the fit) */
@@ -83,6 +87,15 @@ static void write_line(const hm_monitor_status *st, double t) {
   jw_int(&w, "line_harmonics", (long)md->line_harmonics);
   jw_number(&w, "line_strongest_hz", md->lines_found ? md->line_strongest_hz : NAN);
   jw_number(&w, "line_strongest_mps2", md->lines_found ? md->line_strongest_mps2 : NAN);
+  /* lone lines set aside, and a narrow peak that may be a line or the mode (modal.h, margin.h) */
+  jw_int(&w, "lone_lines", (long)md->lone_lines);
+  jw_number(&w, "lone_line_hz", md->lone_lines ? md->lone_line_hz[0] : NAN);
+  jw_number(&w, "lone_line_mps2", md->lone_lines ? md->lone_line_mps2[0] : NAN);
+  jw_number(&w, "lone_line_wavelength_m",
+            md->lone_lines && md->lone_line_hz[0] > 0.0 ? hm_mps_from_kmh(st->mode_speed_kmh) / md->lone_line_hz[0] : NAN);
+  jw_bool(&w, "narrow_peak", md->narrow_peak);
+  jw_number(&w, "narrow_peak_hz", md->narrow_peak ? md->narrow_peak_hz : NAN);
+  jw_string(&w, "narrow_peak_taken_for", hm_narrow_verdict_text(g->narrow));
   jw_int(&w, "windows_used", (long)g->n_windows);
   /* the margin: model-based and model-free Hopf speeds */
   jw_bool(&w, "conicity_valid", g->conicity_valid);
@@ -100,15 +113,19 @@ static void write_line(const hm_monitor_status *st, double t) {
   jw_int(&w, "misfit_windows", (long)g->n_misfits);
   jw_int(&w, "conicity_changes", (long)g->n_changes);
   jw_number(&w, "last_conicity_change_s", g->n_changes ? g->last_change_s : NAN);
+  jw_int(&w, "windows_since_change", (long)g->windows_since_change);
+  jw_int(&w, "conicity_outside_prior", (long)g->outside_prior);
   const int b = s->boundaries_valid; /* no margins are shown as current without data */
   jw_number(&w, "conicity_used", b ? s->conicity : NAN);
   jw_bool(&w, "conicity_from_estimate", b && s->conicity_from_estimate);
   jw_bool(&w, "conicity_from_prior", b && s->conicity_from_prior);
+  jw_bool(&w, "model_interval_used", b && s->model_interval_used);
   jw_number(&w, "hopf_kmh", b ? s->boundaries.hopf_speed_kmh : NAN);
   jw_number(&w, "hopf_kmh_low", b ? s->hopf_low_kmh : NAN);
   jw_number(&w, "hopf_kmh_high", b ? s->hopf_high_kmh : NAN);
   jw_number(&w, "warn_from_kmh", b ? s->warn_from_kmh : NAN);
   jw_number(&w, "watch_from_kmh", b ? s->watch_from_kmh : NAN);
+  jw_number(&w, "warn_risk", b ? s->warn_risk : NAN);
   jw_number(&w, "anticipation_kmh", b ? s->anticipation_kmh : NAN);
   jw_number(&w, "lowest_cycle_kmh", b ? s->boundaries.lowest_cycle_speed_kmh : NAN);
   jw_number(&w, "margin_hopf_kmh", b ? s->margin_hopf_kmh : NAN);

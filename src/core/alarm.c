@@ -23,6 +23,7 @@ struct hm_alarm_s {
   int calm;               /* the release conditions hold since calm_since */
   double calm_since;
   double displacement_limit_m; /* the displacement criterion's limit (0: off) */
+  hm_measurement_point point; /* where the accelerometer is */
   double hunted_at_kmh;   /* the lowest speed at which a criterion was met during the latch (INFINITY: none) */
   int precise;            /* the estimate was used alone at the last update with data (its hysteresis) */
   double v_prev_kmh, t_prev_s, dvdt_kmh_s; /* the speed's trend: an exponential average of dv/dt over ~5 s */
@@ -64,6 +65,8 @@ const char *hm_reason_text(hm_reason r) {
     case HM_REASON_BAD_SAMPLE_RATE: return "acceleration at a sample rate the filters cannot use";
     case HM_REASON_DISPLACEMENT_CRITERION: return "displacement amplitude criterion exceeded";
     case HM_REASON_PARTLY_BLIND: return "partly blind: samples of the last 10 s lost";
+    case HM_REASON_OUTSIDE_PRIOR: return "the identified conicity lies outside the prior's range";
+    case HM_REASON_NARROW_PEAK: return "a narrow peak at the hunting frequency: a line, or the mode at its Hopf speed";
   }
   return "?";
 }
@@ -185,6 +188,16 @@ void hm_alarm_reset(hm_alarm a) {
   a->cache[0].valid = a->cache[1].valid = 0;
 }
 
+void hm_alarm_set_measurement_point(hm_alarm a, hm_measurement_point point) {
+  if (a && (point == HM_POINT_WHEELSET || point == HM_POINT_BOGIE_FRAME)) a->point = point;
+}
+
+void hm_alarm_prior(const hm_alarm a, double *lo, double *hi) {
+  if (!a) return;
+  if (lo) *lo = a->cfg.conicity_prior_low;
+  if (hi) *hi = a->cfg.conicity_prior_high;
+}
+
 void hm_alarm_set_displacement_limit(hm_alarm a, double limit_m) {
   if (a && isfinite(limit_m) && limit_m >= 0.0) a->displacement_limit_m = limit_m;
 }
@@ -248,6 +261,9 @@ static hm_level raw_level(const hm_alarm a, const hm_estimate *e, const hm_margi
   if (v_ahead >= s->watch_from_kmh - hv_watch)
     return *reason = HM_REASON_APPROACHING_HOPF, HM_LEVEL_WATCH;
   if (g && g->model_mismatch) return *reason = HM_REASON_MODEL_MISMATCH, HM_LEVEL_WATCH;
+  if (g && g->conicity_valid && g->outside_prior && c->use_conicity_estimate)
+    return *reason = HM_REASON_OUTSIDE_PRIOR, HM_LEVEL_WATCH;
+  if (s->narrow_peak_ambiguous) return *reason = HM_REASON_NARROW_PEAK, HM_LEVEL_WATCH;
   if (e->sample_rate_mismatch) return *reason = HM_REASON_RATE_MISMATCH, HM_LEVEL_WATCH;
   if (e->loss_fraction > c->blind_fraction) return *reason = HM_REASON_PARTLY_BLIND, HM_LEVEL_WATCH;
   if (v < s->boundaries.lowest_cycle_speed_kmh) return *reason = HM_REASON_BELOW_LOWEST_CYCLE, HM_LEVEL_OK;
@@ -320,15 +336,19 @@ static double warn_below_point(double point_kmh, double low_kmh, double margin_k
 /* The conicity in use, the Hopf interval and the boundaries at the current speed; the table's status on failure. */
 static hm_status assess(hm_alarm a, const hm_estimate *e, const hm_margin_estimate *g, hm_assessment *s) {
   const hm_alarm_config *c = &a->cfg;
+  const int axle = a->point == HM_POINT_WHEELSET;
   const int have = c->use_conicity_estimate && g && g->conicity_valid && g->hopf_model_valid;
-  /* a vehicle that does not behave like its model gets no model-based interval narrower than the prior */
+  /* the model-based interval counts from an axle-box sensor on a vehicle that behaves like its model (alarm.h) */
+  const int usable = have && axle && !g->model_mismatch;
   const double max_se = a->precise ? HM_ALARM_SE_HYSTERESIS * c->conicity_max_se : c->conicity_max_se;
-  const int precise = have && g->conicity_se <= max_se && !g->model_mismatch;
+  const int unconfirmed_change = g && g->n_changes > 0 && g->windows_since_change < 2;
+  const int precise = usable && g->conicity_se <= max_se && !g->outside_prior && !unconfirmed_change;
   /* the prior's interval, and the uncertain estimate's where it is the more cautious */
   double lambda = c->conicity_fallback, lambda_opt = c->conicity_prior_low;
   double lo = a->prior_hopf_low_kmh, hi = a->prior_hopf_high_kmh;
   s->conicity_from_estimate = precise;
   s->conicity_from_prior = !precise;
+  s->model_interval_used = usable;
   s->conicity_se = 0.0;
   if (precise) {
     lambda = g->conicity;
@@ -336,17 +356,18 @@ static hm_status assess(hm_alarm a, const hm_estimate *e, const hm_margin_estima
     lo = g->hopf_model_low_kmh;
     hi = g->hopf_model_high_kmh;
     s->conicity_se = g->conicity_se;
-  } else if (have) {
+  } else if (usable) {
     if (g->hopf_model_kmh < hm_linear_hopf_kmh(&a->veh, lambda)) lambda = g->conicity, s->conicity_se = g->conicity_se;
     lo = fmin(lo, g->hopf_model_low_kmh);
     if (g->hopf_model_high_kmh < hi) hi = g->hopf_model_high_kmh, lambda_opt = g->conicity_low;
   }
-  /* the model-free interval's lower end counts when the vehicle does not behave like its model, and whenever its
-   * regression has residuals to check it (three windows or more); with a mismatch its upper end bounds too */
-  const int free_counts = g && g->hopf_free_valid && (g->model_mismatch || g->n_windows >= HM_ALARM_FREE_MIN_WINDOWS);
+  /* the model-free interval's lower end counts when the model-based one does not (a mismatch, a sensor off the axle
+   * box), and whenever its regression has residuals to check it (three windows or more); then its upper end too */
+  const int free_alone = g && (g->model_mismatch || !axle);
+  const int free_counts = g && g->hopf_free_valid && (free_alone || g->n_windows >= HM_ALARM_FREE_MIN_WINDOWS);
   if (free_counts) {
     lo = fmin(lo, g->hopf_free_low_kmh);
-    if (g->model_mismatch && g->hopf_free_high_kmh < hi) hi = g->hopf_free_high_kmh;
+    if (free_alone && g->hopf_free_high_kmh < hi) hi = g->hopf_free_high_kmh;
   }
   s->conicity = lambda;
   hm_table_lookup_result b, bo;
@@ -367,12 +388,14 @@ static hm_status assess(hm_alarm a, const hm_estimate *e, const hm_margin_estima
   const double from = precise ? b.hopf_speed_kmh : s->hopf_low_kmh;
   const double z = g && g->interval_z > 0.0 ? g->interval_z : 1.0;
   s->warn_from_kmh = warn_below_point(from, precise ? s->hopf_low_kmh : from, c->warn_speed_margin_kmh, z);
-  if (have && !precise && !g->model_mismatch) {
+  if (usable && !precise) {
     const double lo_e = free_counts ? fmin(g->hopf_model_low_kmh, g->hopf_free_low_kmh) : g->hopf_model_low_kmh;
     s->warn_from_kmh = fmin(a->prior_hopf_low_kmh - c->warn_speed_margin_kmh,
                             warn_below_point(g->hopf_model_kmh, lo_e, c->warn_speed_margin_kmh, z));
   }
   s->watch_from_kmh = from - hypot(h, c->watch_speed_margin_kmh);
+  /* what the WARN rule risks (alarm.h): the interval read as normal, its lower half-width interval_z standard errors */
+  s->warn_risk = precise && h > 0.0 ? 0.5 * erfc((from - s->warn_from_kmh) / (h / z) / sqrt(2.0)) : NAN;
   /* the edge: at the conicity in use where the origin is stable there; inside the Hopf interval above the point
    * estimate, at the interval's optimistic end (found by the lookup at the conicity whose Hopf speed is hopf_high,
    * which the table's affine 1/V^2 makes exact) */
@@ -403,6 +426,7 @@ hm_status hm_alarm_update(hm_alarm a, const hm_estimate *e, const hm_margin_esti
     const hm_status st = assess(a, e, g, &s);
     if (st != HM_OK) return st;
     s.boundaries_valid = 1;
+    s.narrow_peak_ambiguous = g && g->ambiguous_at_s > 0.0 && now - g->ambiguous_at_s <= HM_ALARM_NARROW_HOLD_S;
     s.margin_hopf_kmh = s.boundaries.hopf_speed_kmh - e->speed_kmh;
     s.margin_lowest_cycle_kmh = s.boundaries.lowest_cycle_speed_kmh - e->speed_kmh;
     s.amplitude_m = e->oscillation_valid ? e->amplitude_displacement_m : 0.0;

@@ -10,6 +10,7 @@
 
 typedef struct {
   double t_end_s, speed_kmh;
+  double window_s;              /* its length [s] */
   double sigma, sigma_stat;     /* decay rate and its statistical error [1/s] */
   double lambda, lambda_se;     /* the window's conicity and its total error */
   double lambda_stat, lambda_sys; /* the statistical and systematic parts of that error */
@@ -31,6 +32,10 @@ struct hm_margin_s {
   double pending_misfit_t;
   unsigned long n_changes;
   double last_change_s;
+  size_t since_change;          /* windows stored since the last change (the one that showed it included) */
+  double prior_low, prior_high; /* the conicities the wheels may have worn to (hm_margin_set_prior); 0, 0: none */
+  hm_narrow_verdict narrow;     /* what the latest window's narrow peak was taken for */
+  double narrow_hz, narrow_at_s, ambiguous_at_s;
 };
 
 const char *hm_window_verdict_text(hm_window_verdict v) {
@@ -44,6 +49,8 @@ const char *hm_window_verdict_text(hm_window_verdict v) {
     case HM_WINDOW_MISFIT: return "the model cannot explain its decay rate and frequency together";
     case HM_WINDOW_CHANGE: return "the conicity changed: the windows held were dropped";
     case HM_WINDOW_NONLINEAR: return "a criterion was met during it: hunting is not the linear mode";
+    case HM_WINDOW_AMBIGUOUS:
+      return "a narrow peak: a line, or the mode at its Hopf speed at a conicity nothing else supports: not used";
   }
   return "?";
 }
@@ -102,8 +109,30 @@ hm_status hm_margin_create(const hm_margin_config *cfg, const hm_vehicle *veh, h
 
 void hm_margin_destroy(hm_margin m) { free(m); }
 
+const char *hm_narrow_verdict_text(hm_narrow_verdict v) {
+  switch (v) {
+    case HM_NARROW_NONE: return "none";
+    case HM_NARROW_MODE: return "the hunting mode near its Hopf speed";
+    case HM_NARROW_LINE: return "a line beside the mode";
+    case HM_NARROW_AMBIGUOUS: return "a line or the mode at its Hopf speed: not used";
+  }
+  return "?";
+}
+
+hm_narrow_verdict hm_margin_last_narrow(const hm_margin m) { return m ? m->narrow : HM_NARROW_NONE; }
+
+void hm_margin_set_prior(hm_margin m, double conicity_low, double conicity_high) {
+  if (!m) return;
+  const int ok = isfinite(conicity_low) && isfinite(conicity_high) && conicity_low > 0.0 && conicity_high > conicity_low;
+  m->prior_low = ok ? conicity_low : 0.0;
+  m->prior_high = ok ? conicity_high : 0.0;
+}
+
 void hm_margin_reset(hm_margin m) {
   if (!m) return;
+  m->narrow = HM_NARROW_NONE;
+  m->narrow_hz = m->narrow_at_s = m->ambiguous_at_s = 0.0;
+  m->since_change = 0;
   m->head = m->n = 0;
   m->last_end_s = -INFINITY;
   m->have_pending = 0;
@@ -117,21 +146,23 @@ double hm_margin_hopf_kmh(const hm_margin m, double conicity) {
   return m ? hm_linear_hopf_kmh(&m->veh, conicity) : HM_LINEAR_NO_HOPF_KMH;
 }
 
-/* A window's checks and inversion into *w; the verdict says whether it can be used. */
-static hm_window_verdict prepare(const hm_margin m, double t_end, double speed_kmh, double spread_kmh,
-                                 const hm_mode_estimate *mode, window *w) {
+/* A reading's checks and inversion into *w (a window of window_s seconds); the verdict says whether it can be used. */
+static hm_window_verdict prepare_reading(const hm_margin m, double t_end, double speed_kmh, double spread_kmh,
+                                         double window_s, const hm_mode_reading *mode, window *w) {
   const hm_margin_config *c = &m->cfg;
   if (!mode->valid) return HM_WINDOW_MODE_INVALID;
   if (spread_kmh > c->max_speed_spread_kmh) return HM_WINDOW_SPEED_VARIED;
   if (speed_kmh < c->min_speed_kmh) return HM_WINDOW_TOO_SLOW;
-  if (t_end - mode->window_s < m->last_end_s - 1e-9) return HM_WINDOW_OVERLAPS;
+  if (t_end - window_s < m->last_end_s - 1e-9) return HM_WINDOW_OVERLAPS;
   /* statistical and systematic errors of the measured mode (the leakage of a T s window: about 1 / T) */
-  double sys_sigma = c->decay_rate_model_error * fabs(mode->decay_rate_1_s) + 1.0 / fmax(mode->window_s, 1.0);
+  double sys_sigma = c->decay_rate_model_error * fabs(mode->decay_rate_1_s) + 1.0 / fmax(window_s, 1.0);
+  /* a decay rate at its bound 0 (a line's reading, or a mode narrower than the window resolves) inverted just below */
+  const double sigma = fmin(mode->decay_rate_1_s, -1e-6);
   const double sys_f = c->frequency_model_error * mode->frequency_hz;
   double e_sigma = hypot(mode->decay_rate_se_1_s, sys_sigma);
   const double e_f = hypot(mode->frequency_se_hz, sys_f);
   hm_conicity_inversion inv;
-  if (hm_conicity_from_mode(&m->coef, speed_kmh, mode->decay_rate_1_s, e_sigma, mode->frequency_hz, e_f, 1e-9, 60,
+  if (hm_conicity_from_mode(&m->coef, speed_kmh, sigma, e_sigma, mode->frequency_hz, e_f, 1e-9, 60,
                             &inv) != HM_OK)
     return HM_WINDOW_NO_INVERSION;
   /* the speed's range over the window: the fit averages the decay rates along it; the model's change over half the
@@ -142,7 +173,7 @@ static hm_window_verdict prepare(const hm_margin m, double t_end, double speed_k
       hm_hunting_root(&m->coef, speed_kmh + 0.5 * spread_kmh, inv.conicity, &s_hi, &w_unused) == HM_OK) {
     sys_sigma = hypot(sys_sigma, 0.5 * fabs(s_hi - s_lo));
     e_sigma = hypot(mode->decay_rate_se_1_s, sys_sigma);
-    if (hm_conicity_from_mode(&m->coef, speed_kmh, mode->decay_rate_1_s, e_sigma, mode->frequency_hz, e_f, 1e-9, 60,
+    if (hm_conicity_from_mode(&m->coef, speed_kmh, sigma, e_sigma, mode->frequency_hz, e_f, 1e-9, 60,
                               &inv) != HM_OK)
       return HM_WINDOW_NO_INVERSION;
   }
@@ -154,13 +185,59 @@ static hm_window_verdict prepare(const hm_margin m, double t_end, double speed_k
   const double lambda_sys = hypot(js * sys_sigma, jf * sys_f) / info;
   w->t_end_s = t_end;
   w->speed_kmh = speed_kmh;
-  w->sigma = mode->decay_rate_1_s;
+  w->window_s = window_s;
+  w->sigma = sigma;
   w->sigma_stat = mode->decay_rate_se_1_s;
   w->lambda = inv.conicity;
   w->lambda_se = inv.conicity_se;
   w->lambda_sys = fmin(lambda_sys, inv.conicity_se);
   w->lambda_stat = sqrt(fmax(inv.conicity_se * inv.conicity_se - w->lambda_sys * w->lambda_sys, 0.0));
   return HM_WINDOW_USED;
+}
+
+/* The estimate of the windows held at t (their inverse-variance mean; conicity_valid 0 without any). */
+static void model_based(const hm_margin m, const window *const *ws, size_t n, hm_margin_estimate *r);
+static size_t held(const hm_margin m, double now, const window **ws);
+
+/* A window's conicity that what is known supports: within change_z combined standard errors of the windows held,
+ * or without any, the prior's range within interval_z of its error (or no prior given). */
+static int supported(const hm_margin m, const window *w) {
+  const window *ws[HM_MARGIN_MAX_WINDOWS];
+  const size_t n = held(m, w->t_end_s, ws);
+  hm_margin_estimate r;
+  memset(&r, 0, sizeof r);
+  model_based(m, ws, n, &r);
+  if (r.conicity_valid) return fabs(w->lambda - r.conicity) <= m->cfg.change_z * hypot(w->lambda_se, r.conicity_se);
+  const double z = m->cfg.interval_z * w->lambda_se;
+  return m->prior_high <= 0.0 || (w->lambda + z >= m->prior_low && w->lambda - z <= m->prior_high);
+}
+
+/* A window's checks and inversion into *w. A narrow peak (modal.h) is the hunting mode near its Hopf speed when the
+ * model can produce it at this speed and what is known supports its conicity; else a line when the reading without
+ * it is a mode of its own (the model cannot produce the narrow one, or the window held a second resonance beside it,
+ * or that mode lies over 1 Hz away) that what is known supports; else it cannot be told (HM_WINDOW_AMBIGUOUS: a
+ * line at the hunting frequency reads as the mode at its Hopf speed, a sinusoid at 14 Hz at 400 km/h as a conicity
+ * of 0.22 where the prior says 0.11-0.17). *narrow says which. */
+static hm_window_verdict prepare(const hm_margin m, double t_end, double speed_kmh, double spread_kmh,
+                                 const hm_mode_estimate *mode, window *w, hm_narrow_verdict *narrow) {
+  hm_mode_reading primary;
+  hm_mode_estimate_reading(mode, &primary);
+  const hm_window_verdict v = prepare_reading(m, t_end, speed_kmh, spread_kmh, mode->window_s, &primary, w);
+  *narrow = HM_NARROW_NONE;
+  if (!mode->narrow_peak) return v;
+  if (v == HM_WINDOW_USED && supported(m, w)) return *narrow = HM_NARROW_MODE, v;
+  window wl;
+  const hm_window_verdict vl =
+      prepare_reading(m, t_end, speed_kmh, spread_kmh, mode->window_s, &mode->line_reading, &wl);
+  const int impossible = v == HM_WINDOW_MISFIT || v == HM_WINDOW_NO_INVERSION;
+  const int beside = primary.poles == 2 || fabs(mode->line_reading.frequency_hz - primary.frequency_hz) > 1.0;
+  if (vl == HM_WINDOW_USED && (impossible || beside) && supported(m, &wl)) {
+    *w = wl;
+    return *narrow = HM_NARROW_LINE, vl;
+  }
+  if (impossible && vl != HM_WINDOW_USED) return *narrow = HM_NARROW_LINE, vl; /* a line and no mode beside it */
+  if (v != HM_WINDOW_USED && v != HM_WINDOW_MISFIT && v != HM_WINDOW_NO_INVERSION) return v; /* not for this reason */
+  return *narrow = HM_NARROW_AMBIGUOUS, HM_WINDOW_AMBIGUOUS;
 }
 
 /* Keep a window (the ring drops the oldest beyond its size); any provisional one is superseded. */
@@ -170,6 +247,7 @@ static void store(hm_margin m, const window *w) {
   if (m->n < HM_MARGIN_MAX_WINDOWS) ++m->n;
   m->last_end_s = w->t_end_s;
   m->have_pending = 0;
+  ++m->since_change;
 }
 
 static void misfit_push(hm_margin m, double t) {
@@ -177,8 +255,6 @@ static void misfit_push(hm_margin m, double t) {
   m->misfit_head = (m->misfit_head + 1) % HM_MARGIN_MAX_WINDOWS;
   if (m->misfit_n < HM_MARGIN_MAX_WINDOWS) ++m->misfit_n;
 }
-
-static void model_based(const hm_margin m, const window *const *ws, size_t n, hm_margin_estimate *r);
 
 /* The windows held (newest first) within memory_s of now; their count. */
 static size_t held(const hm_margin m, double now, const window **ws) {
@@ -192,7 +268,8 @@ static size_t held(const hm_margin m, double now, const window **ws) {
 }
 
 /* A window whose conicity is more than change_z combined standard errors from the mean of those held: the
- * conicity changed. Everything held is dropped (the new window too: it may straddle the change). */
+ * conicity changed. The windows held are dropped and the new one is kept, committed (it is the evidence of the
+ * change: issue #27; the alarm takes the more cautious of it and the prior until a second window agrees). */
 static int changed(hm_margin m, const window *w) {
   const window *ws[HM_MARGIN_MAX_WINDOWS];
   const size_t n = held(m, w->t_end_s, ws);
@@ -203,25 +280,33 @@ static int changed(hm_margin m, const window *w) {
     return 0;
   m->head = m->n = 0;
   m->have_pending = 0;
-  m->last_end_s = w->t_end_s;
   m->n_changes++;
   m->last_change_s = w->t_end_s;
+  m->since_change = 0;
+  store(m, w);
   return 1;
+}
+
+/* What the window's narrow peak was taken for, remembered for the estimate. */
+static void note_narrow(hm_margin m, double t_end, const hm_mode_estimate *mode, hm_narrow_verdict narrow) {
+  m->narrow = narrow;
+  m->narrow_hz = mode->narrow_peak ? mode->narrow_peak_hz : 0.0;
+  m->narrow_at_s = t_end;
+  if (narrow == HM_NARROW_AMBIGUOUS) m->ambiguous_at_s = t_end;
 }
 
 hm_status hm_margin_add_window(hm_margin m, double t_end, double speed_kmh, double spread_kmh,
                                const hm_mode_estimate *mode, hm_window_verdict *verdict) {
   if (!m || !mode || !verdict || !isfinite(t_end) || !isfinite(speed_kmh) || !isfinite(spread_kmh)) return HM_EINVAL;
   window w;
-  *verdict = prepare(m, t_end, speed_kmh, spread_kmh, mode, &w);
+  hm_narrow_verdict narrow;
+  *verdict = prepare(m, t_end, speed_kmh, spread_kmh, mode, &w, &narrow);
+  note_narrow(m, t_end, mode, narrow);
   m->pending_misfit = 0; /* a committed window ends the stretch's provisional one */
   if (*verdict == HM_WINDOW_MISFIT) misfit_push(m, t_end);
   if (*verdict != HM_WINDOW_USED) return HM_OK;
-  if (changed(m, &w)) {
-    *verdict = HM_WINDOW_CHANGE;
-    return HM_OK;
-  }
-  store(m, &w);
+  if (changed(m, &w)) *verdict = HM_WINDOW_CHANGE;
+  else store(m, &w);
   return HM_OK;
 }
 
@@ -229,10 +314,12 @@ hm_status hm_margin_set_pending(hm_margin m, double t_end, double speed_kmh, dou
                                 const hm_mode_estimate *mode, hm_window_verdict *verdict) {
   if (!m || !mode || !verdict || !isfinite(t_end) || !isfinite(speed_kmh) || !isfinite(spread_kmh)) return HM_EINVAL;
   window w;
-  *verdict = prepare(m, t_end, speed_kmh, spread_kmh, mode, &w);
+  hm_narrow_verdict narrow;
+  *verdict = prepare(m, t_end, speed_kmh, spread_kmh, mode, &w, &narrow);
+  note_narrow(m, t_end, mode, narrow);
   m->pending_misfit = *verdict == HM_WINDOW_MISFIT;
   m->pending_misfit_t = t_end;
-  if (*verdict == HM_WINDOW_USED && changed(m, &w)) *verdict = HM_WINDOW_CHANGE;
+  if (*verdict == HM_WINDOW_USED && changed(m, &w)) *verdict = HM_WINDOW_CHANGE; /* committed, as evidence */
   m->have_pending = *verdict == HM_WINDOW_USED;
   if (m->have_pending) m->pending = w;
   return HM_OK;
@@ -393,6 +480,14 @@ void hm_margin_read(const hm_margin m, double now, hm_margin_estimate *out) {
   r.n_misfits += (unsigned)m->pending_misfit;
   r.n_changes = m->n_changes;
   r.last_change_s = m->last_change_s;
+  r.windows_since_change = (unsigned)(m->n_changes ? m->since_change + (size_t)m->have_pending : (size_t)n);
+  r.narrow = m->narrow;
+  r.narrow_peak_hz = m->narrow_hz;
+  r.narrow_at_s = m->narrow_at_s;
+  r.ambiguous_at_s = m->ambiguous_at_s;
+  /* an estimate outside the prior's range by more than interval_z of its error */
+  if (r.conicity_valid && m->prior_high > 0.0)
+    r.outside_prior = r.conicity_low > m->prior_high ? 1 : r.conicity_high < m->prior_low ? -1 : 0;
   r.model_mismatch = (r.hopf_model_valid && r.hopf_free_valid &&
                       (r.hopf_model_high_kmh < r.hopf_free_low_kmh || r.hopf_free_high_kmh < r.hopf_model_low_kmh)) ||
                      r.n_misfits >= 2;

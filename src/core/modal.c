@@ -241,6 +241,26 @@ void hm_mode_estimate_use_reading(hm_mode_estimate *e, const hm_mode_reading *r)
   e->iterations = r->iterations;
 }
 
+void hm_mode_estimate_reading(const hm_mode_estimate *e, hm_mode_reading *r) {
+  if (!e || !r) return;
+  memset(r, 0, sizeof *r);
+  r->valid = e->valid;
+  r->informative = e->informative;
+  r->frequency_hz = e->frequency_hz;
+  r->frequency_se_hz = e->frequency_se_hz;
+  r->decay_rate_1_s = e->decay_rate_1_s;
+  r->decay_rate_se_1_s = e->decay_rate_se_1_s;
+  r->damping_ratio = e->damping_ratio;
+  r->damping_ratio_se = e->damping_ratio_se;
+  r->peak_to_mean = e->peak_to_mean;
+  r->poles = e->poles;
+  r->second_frequency_hz = e->second_frequency_hz;
+  r->second_decay_rate_1_s = e->second_decay_rate_1_s;
+  r->two_pair_lr = e->two_pair_lr;
+  r->peak_core_z = e->peak_core_z;
+  r->iterations = e->iterations;
+}
+
 /* One window's geometry: its band bins k0..k1, bin spacing, length, the periodogram's reference frequency and the
  * padding's factor nfft / n. */
 typedef struct {

@@ -89,6 +89,14 @@ static void chunk_clear(speed_chunk *k) {
   k->sum = k->n = k->duration_s = 0.0;
 }
 
+/* The alarm's prior (resolved for the vehicle) is the margin's too: it judges narrow peaks and reports estimates
+ * outside it. */
+static void share_prior(hm_monitor m) {
+  double lo = 0.0, hi = 0.0;
+  hm_alarm_prior(m->alarm, &lo, &hi);
+  hm_margin_set_prior(m->margin, lo, hi);
+}
+
 static void restart_stream(hm_monitor m) {
   m->n_chunks = m->chunk_head = 0;
   chunk_clear(&m->cur);
@@ -135,6 +143,8 @@ hm_status hm_monitor_create_parallel(const hm_monitor_config *cfg, const hm_vehi
     return st;
   }
   hm_alarm_set_displacement_limit(m->alarm, cfg->estimator.displacement_limit_m);
+  hm_alarm_set_measurement_point(m->alarm, cfg->estimator.measurement_point);
+  share_prior(m);
   m->modal_ok = 1;
   m->verdict = HM_WINDOW_MODE_INVALID; /* no fit yet */
   m->large_at = -INFINITY;
@@ -232,7 +242,10 @@ static void fit(hm_monitor m, double t) {
   } else {
     hm_margin_set_pending(m->margin, t, m->mode_speed, m->mode_spread, &e, &m->verdict);
   }
-  if (m->verdict == HM_WINDOW_CHANGE) m->committed_until = t; /* the next window starts after the change */
+  if (m->verdict == HM_WINDOW_CHANGE) m->committed_until = t; /* the change's window is committed (margin.h) */
+  /* a narrow peak the margin took for a line: the mode shown is the one beside it */
+  if (m->mode.narrow_peak && hm_margin_last_narrow(m->margin) == HM_NARROW_LINE)
+    hm_mode_estimate_use_reading(&m->mode, &m->mode.line_reading);
 }
 
 hm_status hm_monitor_push_accel(hm_monitor m, double t, double a) {
@@ -320,6 +333,7 @@ hm_status hm_monitor_set_runtime_settings(hm_monitor m, const hm_monitor_config 
   if ((st = hm_alarm_set_config(m->alarm, &c.alarm, &m->veh, why, len)) != HM_OK) return st;
   hm_alarm_set_displacement_limit(m->alarm, c.estimator.displacement_limit_m);
   m->cfg = c;
+  share_prior(m);
   return HM_OK;
 }
 

@@ -561,6 +561,108 @@ static void anticipates_a_sustained_acceleration(void) {
   hm_alarm_destroy(a);
 }
 
+/* What the model may not explain (issue #26), with the default prior (0.1358 -+ 0.03: Hopf 464.8-593.8 km/h by the
+ * closed form): a precise estimate of 0.08 (Hopf 690 km/h, the dangerous direction) outside the prior raises WATCH
+ * and the interval stays the prior's (the more cautious of each end), so at 470 km/h WARN as the prior gives; 0.29
+ * (Hopf 350 km/h, cautious) lowers it: ALARM at 360 km/h; with model_mismatch, and from a bogie-frame sensor, the
+ * model-based interval is not used (the prior's at 470 km/h, WARN, where the estimate of 0.16 alone gives more
+ * room); a conicity change's first window is combined with the prior (the more cautious), the second used alone;
+ * an ambiguous narrow peak within 60 s raises WATCH. The WARN rule's risk: with h/2 = 1 standard error above the
+ * 10 km/h margin, Phi(-1) = 0.1587; with the margin larger, Phi(-10 / se). */
+static void what_the_model_may_not_explain(void) {
+  const double prior_lo = hopf_closed_form(0.1658), prior_hi = hopf_closed_form(0.1058);
+  hm_margin_estimate low = identified(), high = identified();
+  low.conicity = 0.08, low.conicity_low = 0.074, low.conicity_high = 0.086, low.outside_prior = -1;
+  low.hopf_model_kmh = hopf_closed_form(0.08);
+  low.hopf_model_low_kmh = hopf_closed_form(0.086), low.hopf_model_high_kmh = hopf_closed_form(0.074);
+  high.conicity = 0.29, high.conicity_low = 0.284, high.conicity_high = 0.296, high.outside_prior = 1;
+  high.hopf_model_kmh = hopf_closed_form(0.29);
+  high.hopf_model_low_kmh = hopf_closed_form(0.296), high.hopf_model_high_kmh = hopf_closed_form(0.284);
+  hm_alarm a = make_prior(0.0, 0.0);
+  hm_assessment s;
+  hm_estimate e = estimate(470.0, 0.0);
+  HM_CHECK(hm_alarm_update(a, &e, &low, 0.0, &s) == HM_OK && s.level == HM_LEVEL_WARN && !s.conicity_from_estimate,
+           "0.08 at 470 km/h: %s (%s), from estimate %d", hm_level_name(s.level), hm_reason_text(s.reason),
+           s.conicity_from_estimate);
+  HM_CHECK_DELTA(s.hopf_low_kmh, prior_lo, 1e-9, "0.08: the prior's low end");
+  HM_CHECK_DELTA(s.hopf_high_kmh, prior_hi, 1e-9, "0.08: the prior's high end");
+  hm_alarm_destroy(a);
+  a = make_prior(0.0, 0.0);
+  e = estimate(400.0, 0.0);
+  HM_CHECK(hm_alarm_update(a, &e, &low, 0.0, &s) == HM_OK && s.level == HM_LEVEL_WATCH &&
+               s.reason == HM_REASON_OUTSIDE_PRIOR,
+           "0.08 at 400 km/h: %s (%s)", hm_level_name(s.level), hm_reason_text(s.reason));
+  hm_alarm_destroy(a);
+  a = make_prior(0.0, 0.0);
+  e = estimate(hopf_closed_form(0.284) + 1.0, 0.0);
+  HM_CHECK(hm_alarm_update(a, &e, &high, 0.0, &s) == HM_OK && s.level == HM_LEVEL_ALARM &&
+               s.reason == HM_REASON_ABOVE_HOPF,
+           "0.29: %s (%s)", hm_level_name(s.level), hm_reason_text(s.reason));
+  HM_CHECK_DELTA(s.hopf_low_kmh, hopf_closed_form(0.296), 1e-9, "0.29 lowers the low end");
+  HM_CHECK_DELTA(s.hopf_high_kmh, hopf_closed_form(0.284), 1e-9, "0.29 lowers the high end");
+  hm_alarm_destroy(a);
+  /* mismatch and a frame sensor: the prior at 470 km/h (WARN), not the estimate (0.16 alone: WARN from 463.8) */
+  hm_margin_estimate g = identified();
+  for (int k = 0; k < 2; ++k) {
+    hm_margin_estimate gk = g;
+    a = make_prior(0.0, 0.0);
+    if (k == 0) gk.model_mismatch = 1;
+    else hm_alarm_set_measurement_point(a, HM_POINT_BOGIE_FRAME);
+    e = estimate(460.0, 0.0);
+    HM_CHECK(hm_alarm_update(a, &e, &gk, 0.0, &s) == HM_OK && !s.model_interval_used && !s.conicity_from_estimate,
+             "%s: model interval used %d", k ? "frame" : "mismatch", s.model_interval_used);
+    HM_CHECK_DELTA(s.hopf_low_kmh, prior_lo, 1e-9, "the prior's low end");
+    HM_CHECK_DELTA(s.hopf_high_kmh, prior_hi, 1e-9, "the prior's high end");
+    HM_CHECK_DELTA(s.warn_from_kmh, prior_lo - 10.0, 1e-9, "WARN from the prior's low end less 10 km/h");
+    hm_alarm_destroy(a);
+  }
+  /* a frame sensor with the model-free interval valid: it bounds both ends */
+  hm_margin_estimate fr = g;
+  fr.hopf_free_valid = 1, fr.n_windows = 2;
+  fr.hopf_free_kmh = 500.0, fr.hopf_free_low_kmh = 480.0, fr.hopf_free_high_kmh = 530.0;
+  a = make_prior(0.0, 0.0);
+  hm_alarm_set_measurement_point(a, HM_POINT_BOGIE_FRAME);
+  e = estimate(440.0, 0.0);
+  HM_CHECK(hm_alarm_update(a, &e, &fr, 0.0, &s) == HM_OK, "frame, model-free");
+  HM_CHECK_DELTA(s.hopf_low_kmh, prior_lo, 1e-9, "frame: the lower of the prior's and the model-free low ends");
+  HM_CHECK_DELTA(s.hopf_high_kmh, 530.0, 1e-9, "frame: the model-free high end");
+  hm_alarm_destroy(a);
+  /* a change's first window: with the prior, the more cautious; the second alone */
+  hm_margin_estimate ch = g;
+  ch.n_changes = 1, ch.windows_since_change = 1;
+  a = make_prior(0.0, 0.0);
+  e = estimate(400.0, 0.0);
+  HM_CHECK(hm_alarm_update(a, &e, &ch, 0.0, &s) == HM_OK && !s.conicity_from_estimate && s.model_interval_used,
+           "first window after a change: alone %d", s.conicity_from_estimate);
+  HM_CHECK_DELTA(s.hopf_low_kmh, fmin(prior_lo, g.hopf_model_low_kmh), 1e-9, "after a change: the lower low end");
+  HM_CHECK_DELTA(s.hopf_high_kmh, fmin(prior_hi, g.hopf_model_high_kmh), 1e-9, "after a change: the lower high end");
+  ch.windows_since_change = 2;
+  HM_CHECK(hm_alarm_update(a, &e, &ch, 0.1, &s) == HM_OK && s.conicity_from_estimate, "second window: alone");
+  hm_alarm_destroy(a);
+  /* an ambiguous narrow peak 30 s ago: WATCH; 70 s ago: not */
+  hm_margin_estimate amb = g;
+  amb.ambiguous_at_s = 100.0;
+  a = make_prior(0.0, 0.0);
+  HM_CHECK(hm_alarm_update(a, &e, &amb, 130.0, &s) == HM_OK && s.level == HM_LEVEL_WATCH &&
+               s.reason == HM_REASON_NARROW_PEAK,
+           "narrow peak: %s (%s)", hm_level_name(s.level), hm_reason_text(s.reason));
+  hm_alarm_destroy(a);
+  a = make_prior(0.0, 0.0);
+  HM_CHECK(hm_alarm_update(a, &e, &amb, 170.0, &s) == HM_OK && s.level == HM_LEVEL_OK, "70 s later: %s",
+           hm_level_name(s.level));
+  /* the WARN rule's risk */
+  HM_CHECK(hm_alarm_update(a, &e, &g, 171.0, &s) == HM_OK && s.conicity_from_estimate, "identified");
+  const double se = (g.hopf_model_kmh - g.hopf_model_low_kmh) / 2.0;
+  HM_CHECK_DELTA(s.warn_risk, 0.5 * erfc(fmax(10.0, se) / se / sqrt(2.0)), 1e-12, "risk, 0.16 +- 0.003");
+  hm_margin_estimate wide = g;
+  wide.conicity_se = 0.009, wide.conicity_low = 0.142, wide.conicity_high = 0.178;
+  wide.hopf_model_low_kmh = hopf_closed_form(0.178), wide.hopf_model_high_kmh = hopf_closed_form(0.142);
+  HM_CHECK(hm_alarm_update(a, &e, &wide, 172.0, &s) == HM_OK && s.conicity_from_estimate, "identified, wide");
+  HM_CHECK((g.hopf_model_kmh - wide.hopf_model_low_kmh) / 2.0 > 10.0, "one standard error above the margin");
+  HM_CHECK_DELTA(s.warn_risk, 0.1586552539, 1e-9, "risk at one standard error: Phi(-1)");
+  hm_alarm_destroy(a);
+}
+
 int main(void) {
   hm_vehicle_default(&vehicle);
   if (hm_test_small_table(&table) != HM_OK) {
@@ -576,5 +678,6 @@ int main(void) {
   HM_RUN(bad_configuration_and_input);
   HM_RUN(anticipates_a_sustained_acceleration);
   hm_table_destroy(table);
+  HM_RUN(what_the_model_may_not_explain);
   HM_TEST_EXIT();
 }
