@@ -77,9 +77,13 @@
  * interval brings the interval's lower end down to that speed (hopf_low_from_hunting): the vehicle hunted there,
  * so its Hopf speed may be no higher (or it runs in the bistable band after a large disturbance), and the latch is
  * released only below it (on issue #18's conicity step at 470 km/h the windows of the old conicity had held the
- * interval at 492-579 km/h for a minute while the wheelset hunted at 470). A speed-only ALARM follows the speed with
- * the hysteresis. Stale
- * input shows NO_DATA but keeps the latch: when data returns the ALARM is back until the calm is seen.
+ * interval at 492-579 km/h for a minute while the wheelset hunted at 470). That speed stays a one-sided bound for
+ * memory_s after the release (hm_alarm_set_memory; the vehicle has shown a Hopf or fold speed at or below it: WARN
+ * from it less warn_speed_margin_kmh on the way back up, issue #27), shown as such (hopf_low_from_hunting,
+ * hunted_at_kmh). A speed-only ALARM follows the speed with the hysteresis. Stale input keeps a held ALARM: the level
+ * stays ALARM with its cause, latched, the margins not current (boundaries_valid 0) and the estimate's accel_valid
+ * or speed_valid false: a sensor lost to violent hunting does not turn "reduce speed" into nothing; the calm is
+ * seen only with data. A restarted time line keeps it too (hm_alarm_restart).
  */
 #ifndef HUNTING_MONITOR_ALARM_H
 #define HUNTING_MONITOR_ALARM_H
@@ -203,8 +207,10 @@ typedef struct {
                                        read as normal with se = its lower half-width / interval_z (one standard error:
                                        0.159); NAN otherwise */
   int narrow_peak_ambiguous;        /* a window of the last HM_ALARM_NARROW_HOLD_S had an ambiguous narrow peak */
-  int hopf_low_from_hunting;        /* hopf_low_kmh is the lowest speed at which the held ALARM's oscillation met a
-                                       criterion (below the interval the estimate or prior gave) */
+  int hopf_low_from_hunting;        /* hopf_low_kmh is the lowest speed at which an oscillation met a criterion, during
+                                       the held ALARM and for memory_s after it (below the interval the estimate or
+                                       prior gave); warn_from_kmh and watch_from_kmh are below it by their margins */
+  double hunted_at_kmh;             /* that speed while it counts (NAN: none) */
   double edge_used_m;               /* the edge amplitude the amplitude rules use (0: none) */
   double margin_hopf_kmh;           /* Hopf speed - speed */
   double margin_lowest_cycle_kmh;   /* lowest cycle speed - speed (negative: inside the bistable band) */
@@ -222,8 +228,17 @@ typedef struct hm_alarm_s *hm_alarm;
 hm_status hm_alarm_create(const hm_alarm_config *cfg, const hm_vehicle *veh, const hm_table table, hm_alarm *out,
                           char *why, size_t why_len);
 void hm_alarm_destroy(hm_alarm alarm);
-/* Back to NO_DATA / starting (the stream was restarted). */
+/* Back to NO_DATA / starting, forgetting a latch and a hunted-at speed (a new vehicle, a fresh start). */
 void hm_alarm_reset(hm_alarm alarm);
+/* The time line restarted (a clock step, a bag looped; times before are not comparable with times after): a held
+ * ALARM stays held with its cause (a latch carries no times that matter) and the hunted-at speed stays a bound (its
+ * age counts again from the next update); the level's hold, the calm seen, the speed's trend start again. */
+void hm_alarm_restart(hm_alarm alarm);
+/* The time line moved by delta_s (a known step): every time the alarm holds moves with it, so ages are kept. */
+void hm_alarm_shift_time(hm_alarm alarm, double delta_s);
+/* How long a speed at which the oscillation met a criterion bounds the interval after the latch's release [s]
+ * (default 900: the margin's memory_s, which the monitor passes). */
+void hm_alarm_set_memory(hm_alarm alarm, double memory_s);
 /* New settings from the next update on, the level and its hold kept (validated as at create: HM_EDOMAIN with the
  * reason in why, and nothing changes); the fallback conicity 0 becomes veh's lambda(0). */
 hm_status hm_alarm_set_config(hm_alarm alarm, const hm_alarm_config *cfg, const hm_vehicle *veh, char *why,

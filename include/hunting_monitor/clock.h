@@ -15,7 +15,10 @@
  * has left the window, then as a clock offset.
  *
  * A clock that steps: a sample whose d departs from the offset by more than max_step_s
- *  - later than the offset says (a stall, a burst of late samples, or the sensor's clock stepped back): used (its
+ *  - later than the offset says with a stamp that continues the stamps used (not earlier than the last, at most
+ *    max_step_s after it): a stall's backlog, draining at any rate: used, never a step (issue #27: a 2 s stall whose
+ *    backlog drained at twice real time read as a step and reset the monitor);
+ *  - later than the offset says otherwise (a burst of late samples, or the sensor's clock stepped back): used (its
  *    stamp is plausible; the estimator refuses it if it is out of order);
  *  - earlier than possible (a stamp ahead of the receiver's now on the sensor's time line by more than max_step_s):
  *    dropped;
@@ -64,6 +67,7 @@ typedef struct {
   unsigned n_blocks, newest;             /* blocks in use, index of the newest */
   double away_since_s;                   /* receipt time since which samples depart by > max_step_s; NaN: none */
   double last_mapped_s;                  /* the last receiver time taken onto the sensor's line (kept monotonic) */
+  double last_stamp_s;                   /* the stamp of the last sample used; NaN: none */
   unsigned long n_steps, n_dropped, n_late; /* clock steps, samples dropped, samples later than max_step_s */
 } hm_clock;
 
@@ -71,6 +75,9 @@ typedef struct {
 hm_status hm_clock_init(hm_clock *c, const hm_clock_config *cfg);
 /* Forget the offset (the receiver's time jumped), keeping the configuration and the counters. */
 void hm_clock_reset(hm_clock *c);
+/* The receiver's clock stepped by delta_s (a ROS time correction) while the sensor's did not: the offset moves with
+ * it, and the sensor's time line, the stamps, is continuous (nothing to restart). */
+void hm_clock_shift(hm_clock *c, double delta_s);
 /* One sample stamped stamp_s (sensor clock) received at receipt_s (receiver clock). HM_EINVAL for NULL or a
  * non-finite time (c untouched). */
 hm_status hm_clock_observe(hm_clock *c, double stamp_s, double receipt_s, hm_clock_verdict *verdict);

@@ -79,30 +79,44 @@ hm_status hm_lines_create(const hm_lines_config *cfg, size_t max_bins, hm_lines 
 void hm_lines_destroy(hm_lines l);
 
 /* Mark in exclude[0..n) the bins of one line at f_hz, ratio times its background, in a window of window_s seconds (the
- * width the comb's teeth get, above); the number of bins newly marked. */
-size_t hm_lines_mark(const hm_lines l, double f_hz, double ratio, size_t n, double df_hz, double window_s,
-                     unsigned char *exclude);
+ * width the comb's teeth get, above), widened by f_hz spread_rel on each side (a line of the track moves with the speed:
+ * over a window whose speed ranged over spread_rel of its mean it covers that much); the number of bins newly marked. */
+size_t hm_lines_mark(const hm_lines l, double f_hz, double ratio, double spread_rel, size_t n, double df_hz,
+                     double window_s, unsigned char *exclude);
+
+/* A line fitted to a peak: its frequency [rad per sample], complex amplitude in the DFT's units (X_j = A D(w_j -
+ * omega) with D(d) = sum_{t<n} e^{-i d t}) and the harmonic F statistic (below). */
+typedef struct {
+  double omega;
+  double amp_re, amp_im;
+  double f_stat;
+} hm_lines_sinusoid;
 
 /*
  * Is the peak at bin k a sinusoid (a harmonic F test)? The rectangular window of n_samples samples (zero-padded to
  * nfft) turns a line at w into the kernel D(w_j - w) at the bins j about it: the complex DFT (re, im) over k -+ 3
  * bins per 1 / T is fitted by one line (its frequency within -+0.6 of 1 / T of the bin, its complex amplitude by least
- * squares) and F = (power explained / 2) / (residual / (2 (2m + 1) - 2)) returned for the 2m + 1 bins. Over a spectrum
- * that is smooth across them (a mode broader than about 3 / T, noise) the bins are independent and F follows
+ * squares) and F = (power explained / 2) / (residual / (2 (2m + 1) - 2)) returned with it for the 2m + 1 bins. Over a
+ * spectrum that is smooth across them (a mode broader than about 3 / T, noise) the bins are independent and F follows
  * F(2, 2 (2m + 1) - 2) (12 degrees of freedom without padding: P(F > 20) = 1.5e-4, a little more for the search in
  * frequency); a line leaves the continuum only and F grows with its power. A mode narrower than about 1 / T is,
- * within one window, a line too. NAN for bad arguments.
+ * within one window, a line too. HM_EINVAL for bad arguments or a bin too near either end (out untouched).
  */
-double hm_lines_sinusoid_f(const double *re, const double *im, size_t nbins, size_t k, size_t n_samples,
-                           size_t nfft);
+hm_status hm_lines_fit_sinusoid(const double *re, const double *im, size_t nbins, size_t k, size_t n_samples,
+                                size_t nfft, hm_lines_sinusoid *out);
+/* Subtract a fitted line from the DFT over bins k_lo..k_hi: its main lobe and its leakage, the continuum beneath
+ * left (a line set aside this way biases no fit beside it; leaving its bins out leaves its side lobes). */
+void hm_lines_subtract(double *re, double *im, size_t k_lo, size_t k_hi, size_t n_samples, size_t nfft,
+                       const hm_lines_sinusoid *line);
 
 /*
- * Look for a comb in power[0..n) (bin k at k df_hz) between f_lo_hz and f_hi_hz, for a window of window_s seconds.
- * exclude[0..n) is set to 1 on the bins to leave out (all of them 0 when no comb is found). HM_EINVAL for NULL
+ * Look for a comb in power[0..n) (bin k at k df_hz) between f_lo_hz and f_hi_hz, for a window of window_s seconds
+ * whose speed ranged over spread_rel of its mean (its teeth widened by that, hm_lines_mark). exclude[0..n) is set to
+ * 1 on the bins to leave out (all of them 0 when no comb is found). HM_EINVAL for NULL
  * arguments, n above max_bins, or a non-positive df_hz or window_s; outputs untouched then.
  */
 hm_status hm_lines_find(hm_lines l, const double *power, size_t n, double df_hz, double window_s, double f_lo_hz,
-                        double f_hi_hz, unsigned char *exclude, hm_lines_result *out);
+                        double f_hi_hz, double spread_rel, unsigned char *exclude, hm_lines_result *out);
 
 #ifdef __cplusplus
 }

@@ -44,8 +44,9 @@
  * and its conicity is supported: within change_z combined standard errors of the windows held or, without any, within
  * the prior's range (hm_margin_set_prior) to interval_z of its error. Else it is a line when the reading without it is
  * a mode of its own (the model cannot produce the narrow one, or a second resonance was fitted beside it, or that
- * mode is over 1 Hz away) and supported the same way; else the window is not used (HM_WINDOW_AMBIGUOUS; the alarm
- * says so). A line at 14 Hz at 400 km/h reads as the mode at its Hopf speed with a conicity of 0.22 where the prior
+ * mode is over 1 Hz away) and supported the same way, or above it (its Hopf speed below what is known: the cautious
+ * reading, which may lower the interval, alarm.h); else the window is not used (HM_WINDOW_AMBIGUOUS; the alarm says
+ * so). A line at 14 Hz at 400 km/h reads as the mode at its Hopf speed with a conicity of 0.22 where the prior
  * says 0.11-0.17: set aside when the mode beside it is found, ambiguous otherwise.
  * model_mismatch, the vehicle not behaving like its model: both valid with disjoint intervals, or two or more
  * misfit windows (a mode the model cannot produce at that speed, e.g. a bogie mode at 8 Hz) within memory_s.
@@ -149,6 +150,8 @@ void hm_margin_reset(hm_margin m);
  * supported by it when no window is held, and an estimate outside it is reported (outside_prior). Invalid values
  * (non-finite, not 0 < low < high) remove it. */
 void hm_margin_set_prior(hm_margin m, double conicity_low, double conicity_high);
+/* The time line moved by delta_s (a known clock step): every window's time moves with it, so their ages are kept. */
+void hm_margin_shift_time(hm_margin m, double delta_s);
 /* What the latest window offered (committed or provisional) took its narrow peak for. */
 hm_narrow_verdict hm_margin_last_narrow(const hm_margin m);
 

@@ -163,9 +163,10 @@ void hm_modal_push(hm_modal m, double accel_mps2);
 /* 1 when enough new data for a fit is in (fit_interval_s since the last one, min_window_s in all). */
 int hm_modal_fit_due(const hm_modal m);
 /* Fit the newest max_window_s of the window (at most window_s; the caller passes less when only the newest part was
- * at a steady speed). HM_OK with out->valid set or cleared (mode outside the band, fewer than min_window_s of data);
+ * at a steady speed), whose speed ranged over speed_spread_rel of its mean (0 if unknown: lines of the track, which move
+ * with the speed, are left out that much wider, lines.h). HM_OK with out->valid set or cleared (mode outside the band, fewer than min_window_s of data);
  * HM_ENOCONV if the scoring did not converge (out untouched); HM_EINVAL for max_window_s <= 0. */
-hm_status hm_modal_fit(hm_modal m, double max_window_s, hm_mode_estimate *out);
+hm_status hm_modal_fit(hm_modal m, double max_window_s, double speed_spread_rel, hm_mode_estimate *out);
 
 #ifdef __cplusplus
 }

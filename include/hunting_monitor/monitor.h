@@ -88,9 +88,14 @@ hm_status hm_monitor_create(const hm_monitor_config *cfg, const hm_vehicle *veh,
 hm_status hm_monitor_create_parallel(const hm_monitor_config *cfg, const hm_vehicle *veh, hm_table table,
                                      hm_parallel_for_fn pfor, void *runner, hm_monitor *out, char *why, size_t why_len);
 void hm_monitor_destroy(hm_monitor m);
-/* Forget the stream (time jumped): estimator, identification, margin (its windows' times are on the old time line)
- * and alarm state. */
+/* Forget the stream (the time line restarted, by an unknown step): estimator, identification, the margin's windows
+ * (their times are on the old line) and the alarm's hold; a held ALARM stays held with its hunted-at speed (a latch
+ * carries no times that matter, hm_alarm_restart). */
 void hm_monitor_reset(hm_monitor m);
+/* The time line stepped by a known delta_s (a sensor clock step, a ROS time correction): the stream restarts
+ * (estimator, identification), but the margin's windows and the alarm keep their ages, every time they hold moved by
+ * delta_s (hm_margin_shift_time, hm_alarm_shift_time). A non-finite delta_s is hm_monitor_reset. */
+void hm_monitor_time_jump(hm_monitor m, double delta_s);
 
 /* One acceleration sample [m/s^2] at t_s; the estimator's status (rejected samples are counted there). */
 hm_status hm_monitor_push_accel(hm_monitor m, double t_s, double accel_mps2);

@@ -24,7 +24,11 @@ struct hm_alarm_s {
   double calm_since;
   double displacement_limit_m; /* the displacement criterion's limit (0: off) */
   hm_measurement_point point; /* where the accelerometer is */
-  double hunted_at_kmh;   /* the lowest speed at which a criterion was met during the latch (INFINITY: none) */
+  double hunted_at_kmh;   /* the lowest speed at which a criterion was met, during the latch and for memory_s after
+                             it (INFINITY: none) */
+  double hunted_t_s;      /* when (the latest time it was met there or lower); NAN: on a time line that restarted,
+                             its age counts from the next update */
+  double memory_s;        /* how long a hunted-at speed bounds the interval (hm_alarm_set_memory) */
   int precise;            /* the estimate was used alone at the last update with data (its hysteresis) */
   double v_prev_kmh, t_prev_s, dvdt_kmh_s; /* the speed's trend: an exponential average of dv/dt over ~5 s */
   int have_trend;
@@ -165,6 +169,7 @@ hm_status hm_alarm_create(const hm_alarm_config *cfg, const hm_vehicle *veh, con
   }
   a->table = table;
   a->hunted_at_kmh = INFINITY;
+  a->memory_s = 900.0;
   a->level = HM_LEVEL_NO_DATA;
   a->reason = HM_REASON_STARTUP;
   *out = a;
@@ -175,17 +180,41 @@ void hm_alarm_destroy(hm_alarm a) { free(a); }
 
 void hm_alarm_reset(hm_alarm a) {
   if (!a) return;
+  a->latched = 0;
+  a->hunted_at_kmh = INFINITY;
+  hm_alarm_restart(a);
   a->level = HM_LEVEL_NO_DATA;
   a->reason = HM_REASON_STARTUP;
+}
+
+void hm_alarm_restart(hm_alarm a) {
+  if (!a) return;
+  if (!a->latched) a->level = HM_LEVEL_NO_DATA, a->reason = HM_REASON_STARTUP;
   a->since = 0.0;
   a->lower_pending = 0;
-  a->latched = a->calm = 0;
-  a->hunted_at_kmh = INFINITY;
+  a->calm = 0;
+  a->hunted_t_s = NAN; /* its age counts again from the next update */
   a->precise = 0;
   a->have_trend = 0;
   a->dvdt_kmh_s = 0.0;
   a->block_n = a->n_blocks = 0;
   a->cache[0].valid = a->cache[1].valid = 0;
+}
+
+void hm_alarm_shift_time(hm_alarm a, double delta_s) {
+  if (!a || !isfinite(delta_s)) return;
+  a->since += delta_s;
+  a->lower_since += delta_s;
+  a->calm_since += delta_s;
+  a->t_prev_s += delta_s;
+  a->hunted_t_s += delta_s;
+  a->block_t0_s += delta_s;
+  a->block_last_s += delta_s;
+  for (unsigned k = 0; k < a->n_blocks; ++k) a->block_t_s[k] += delta_s;
+}
+
+void hm_alarm_set_memory(hm_alarm a, double memory_s) {
+  if (a && isfinite(memory_s) && memory_s > 0.0) a->memory_s = memory_s;
 }
 
 void hm_alarm_set_measurement_point(hm_alarm a, hm_measurement_point point) {
@@ -409,6 +438,26 @@ static hm_status assess(hm_alarm a, const hm_estimate *e, const hm_margin_estima
   return HM_OK;
 }
 
+/* Hunting met a criterion at a speed below the interval: the vehicle's Hopf speed (or, after a large disturbance, its
+ * lowest cycle speed) may be no higher. The lowest such speed of the latch bounds the interval's lower end, and the
+ * WARN and WATCH thresholds below it by their margins, while the ALARM is held and for memory_s after it (alarm.h);
+ * the latch is released only below it. */
+static void hunted_bound(hm_alarm a, const hm_estimate *e, double now, hm_assessment *s) {
+  if (e->rms_exceeded || e->peaks_exceeded || e->displacement_exceeded) {
+    if (!a->latched && a->hunted_at_kmh < INFINITY && !(now - a->hunted_t_s <= a->memory_s))
+      a->hunted_at_kmh = INFINITY; /* a new episode after the memory of the last one ran out */
+    if (e->speed_kmh <= a->hunted_at_kmh) a->hunted_at_kmh = e->speed_kmh, a->hunted_t_s = now;
+  }
+  if (isnan(a->hunted_t_s) && a->hunted_at_kmh < INFINITY) a->hunted_t_s = now; /* a restarted time line */
+  if (!a->latched && !(now - a->hunted_t_s <= a->memory_s)) a->hunted_at_kmh = INFINITY;
+  s->hunted_at_kmh = a->hunted_at_kmh < INFINITY ? a->hunted_at_kmh : NAN;
+  if (!(a->hunted_at_kmh < s->hopf_low_kmh)) return;
+  s->hopf_low_kmh = a->hunted_at_kmh;
+  s->hopf_low_from_hunting = 1;
+  s->warn_from_kmh = fmin(s->warn_from_kmh, a->hunted_at_kmh - a->cfg.warn_speed_margin_kmh);
+  s->watch_from_kmh = fmin(s->watch_from_kmh, a->hunted_at_kmh - a->cfg.watch_speed_margin_kmh);
+}
+
 hm_status hm_alarm_update(hm_alarm a, const hm_estimate *e, const hm_margin_estimate *g, double now, hm_assessment *out) {
   if (!a || !e || !out || !isfinite(now)) return HM_EINVAL;
   const hm_alarm_config *c = &a->cfg;
@@ -422,6 +471,13 @@ hm_status hm_alarm_update(hm_alarm a, const hm_estimate *e, const hm_margin_esti
              : !e->accel_valid         ? HM_REASON_NO_ACCEL
                                        : HM_REASON_NO_SPEED;
     a->block_n = a->n_blocks = 0; /* no speed: the acceleration starts again */
+    if (a->latched) { /* a held ALARM outlives its data: nothing says the oscillation has gone (alarm.h) */
+      target = HM_LEVEL_ALARM;
+      reason = a->latch_reason;
+      a->calm = 0;
+      s.latched = 1;
+      s.release_in_s = c->release_s;
+    }
   } else {
     const hm_status st = assess(a, e, g, &s);
     if (st != HM_OK) return st;
@@ -431,17 +487,7 @@ hm_status hm_alarm_update(hm_alarm a, const hm_estimate *e, const hm_margin_esti
     s.margin_lowest_cycle_kmh = s.boundaries.lowest_cycle_speed_kmh - e->speed_kmh;
     s.amplitude_m = e->oscillation_valid ? e->amplitude_displacement_m : 0.0;
     s.amplitude_margin_m = s.edge_used_m > 0.0 ? s.edge_used_m - s.amplitude_m : 0.0;
-    /* hunting met a criterion at a speed below the interval: the vehicle's Hopf speed may be no higher (or it runs in
-     * the bistable band after a large disturbance): while the ALARM is held the interval reaches down to the lowest
-     * such speed, and the latch is released only below it */
-    if (e->rms_exceeded || e->peaks_exceeded || e->displacement_exceeded)
-      a->hunted_at_kmh = fmin(a->latched ? a->hunted_at_kmh : INFINITY, e->speed_kmh);
-    else if (!a->latched)
-      a->hunted_at_kmh = INFINITY;
-    if (a->hunted_at_kmh < s.hopf_low_kmh) {
-      s.hopf_low_kmh = a->hunted_at_kmh;
-      s.hopf_low_from_hunting = 1;
-    }
+    hunted_bound(a, e, now, &s);
     /* the speed's trend (accelerating toward a threshold makes a lower level short-lived) */
     if (a->have_trend && now > a->t_prev_s) {
       const double dt = now - a->t_prev_s, w = fmin(dt / HM_ALARM_TREND_S, 1.0);
@@ -472,8 +518,7 @@ hm_status hm_alarm_update(hm_alarm a, const hm_estimate *e, const hm_margin_esti
       if (!calm) a->calm = 0;
       else if (!a->calm) a->calm = 1, a->calm_since = now;
       if (a->calm && now - a->calm_since >= c->release_s) {
-        a->latched = 0;
-        a->hunted_at_kmh = INFINITY;
+        a->latched = 0; /* the hunted-at speed stays a bound for memory_s */
       } else {
         target = HM_LEVEL_ALARM;
         reason = a->latch_reason;

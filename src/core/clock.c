@@ -38,6 +38,11 @@ static void anchor(hm_clock *c, double d, double receipt_s) {
   c->last_mapped_s = -INFINITY;
 }
 
+/* A stamp that continues the stamps used (not earlier than the last, at most max_step_s after it): a backlog's. */
+static int continues(const hm_clock *c, double stamp_s) {
+  return isfinite(c->last_stamp_s) && stamp_s >= c->last_stamp_s && stamp_s - c->last_stamp_s <= c->cfg.max_step_s;
+}
+
 hm_status hm_clock_init(hm_clock *c, const hm_clock_config *cfg) {
   if (!c || !cfg) return HM_EINVAL;
   if (hm_clock_config_validate(cfg, NULL, 0) != HM_OK) return HM_EDOMAIN;
@@ -57,6 +62,15 @@ void hm_clock_reset(hm_clock *c) {
   c->newest = 0;
   c->away_since_s = NAN;
   c->last_mapped_s = -INFINITY;
+  c->last_stamp_s = NAN;
+}
+
+void hm_clock_shift(hm_clock *c, double delta_s) {
+  if (!c || !isfinite(delta_s) || !c->have_offset) return;
+  c->offset_s += delta_s;
+  for (unsigned i = 0; i < HM_CLOCK_BLOCKS; ++i) c->block_min_s[i] += delta_s;
+  c->block_start_s += delta_s;
+  if (!isnan(c->away_since_s)) c->away_since_s += delta_s;
 }
 
 /* d enters the window: blocks of window_s / HM_CLOCK_BLOCKS of receipt time; the offset is their least value. */
@@ -87,14 +101,20 @@ hm_status hm_clock_observe(hm_clock *c, double stamp_s, double receipt_s, hm_clo
   if (!isfinite(d)) return HM_EINVAL;
   if (!c->have_offset) {
     anchor(c, d, receipt_s);
+    c->last_stamp_s = stamp_s;
     *verdict = HM_CLOCK_USE;
     return HM_OK;
   }
   const double dev = d - c->offset_s;
-  if (fabs(dev) > c->cfg.max_step_s) {
+  int chained = 1; /* the stamp continues the stamps used (a late one that does not is used, not chained on) */
+  if (dev > c->cfg.max_step_s && continues(c, stamp_s)) { /* a stall's backlog: late, its stamps continuous */
+    c->n_late++;
+    c->away_since_s = NAN;
+  } else if (fabs(dev) > c->cfg.max_step_s) {
     if (isnan(c->away_since_s)) c->away_since_s = receipt_s;
     if (receipt_s - c->away_since_s >= c->cfg.confirm_s) {
       anchor(c, d, receipt_s);
+      c->last_stamp_s = stamp_s;
       c->n_steps++;
       *verdict = HM_CLOCK_STEPPED;
       return HM_OK;
@@ -105,11 +125,13 @@ hm_status hm_clock_observe(hm_clock *c, double stamp_s, double receipt_s, hm_clo
       return HM_OK;
     }
     c->n_late++;  /* late: plausible, used; it cannot lower the least value */
+    chained = 0;
   } else {
     c->away_since_s = NAN;
   }
   enter(c, d, receipt_s);
   c->latency_s = d - c->offset_s;
+  if (chained) c->last_stamp_s = stamp_s;
   *verdict = HM_CLOCK_USE;
   return HM_OK;
 }

@@ -74,10 +74,12 @@ typedef struct {
   size_t k;
 } candidate;
 
-size_t hm_lines_mark(const hm_lines l, double f, double ratio, size_t n, double df, double T, unsigned char *exclude) {
+size_t hm_lines_mark(const hm_lines l, double f, double ratio, double spread_rel, size_t n, double df, double T,
+                     unsigned char *exclude) {
   if (!l || !exclude || !(df > 0.0) || !(T > 0.0) || n == 0) return 0;
   const hm_lines_config *c = &l->cfg;
-  const double w = fmin(c->background_halfwidth_hz, fmax(2.0 / T, sqrt(fmax(ratio, 1.0) / c->leakage) / (HM_PI * T)));
+  const double w = fmin(c->background_halfwidth_hz, fmax(2.0 / T, sqrt(fmax(ratio, 1.0) / c->leakage) / (HM_PI * T))) +
+                   fabs(f) * (isfinite(spread_rel) && spread_rel > 0.0 ? fmin(spread_rel, 0.1) : 0.0);
   const double a = fmax(0.0, ceil((f - w) / df)), b = fmin((double)(n - 1), floor((f + w) / df));
   size_t marked = 0;
   for (double k = a; k <= b; k += 1.0)
@@ -86,7 +88,7 @@ size_t hm_lines_mark(const hm_lines l, double f, double ratio, size_t n, double 
 }
 
 hm_status hm_lines_find(hm_lines l, const double *p, size_t n, double df, double T, double f_lo, double f_hi,
-                        unsigned char *exclude, hm_lines_result *out) {
+                        double spread_rel, unsigned char *exclude, hm_lines_result *out) {
   if (!l || !p || !exclude || !out || n == 0 || n > l->max_bins || !(df > 0.0) || !(T > 0.0)) return HM_EINVAL;
   const hm_lines_config *c = &l->cfg;
   hm_lines_result r;
@@ -183,7 +185,7 @@ hm_status hm_lines_find(hm_lines l, const double *p, size_t n, double df, double
       double ratio = 1.0;
       for (size_t j = 0; j < nc; ++j)
         if (fabs(cand[j].f - fm) <= (0.5 + 0.5 * m) / T) ratio = fmax(ratio, cand[j].ratio);
-      r.bins_excluded += hm_lines_mark(l, fm, ratio, n, df, T, exclude);
+      r.bins_excluded += hm_lines_mark(l, fm, ratio, spread_rel, n, df, T, exclude);
     }
   }
   /* the candidates on no comb, strongest first (a candidate taken is marked 2) */
@@ -210,24 +212,69 @@ static void dirichlet(double d, size_t n, double *dr, double *di) {
   *di = mag * sin(ph);
 }
 
-double hm_lines_sinusoid_f(const double *re, const double *im, size_t nbins, size_t k, size_t n, size_t nfft) {
-  if (!re || !im || n < 4 || nfft < n || k >= nbins) return NAN;
-  const size_t m = (size_t)ceil(3.0 * (double)nfft / (double)n); /* -+3 bins per 1 / T */
-  if (k < m || k + m >= nbins) return NAN;
-  double total = 0.0, explained = 0.0;
-  for (size_t j = k - m; j <= k + m; ++j) total += re[j] * re[j] + im[j] * im[j];
-  for (int step = -12; step <= 12; ++step) { /* the line's frequency, in 1/20 of 1 / T about the peak's bin */
-    const double wl = 2.0 * HM_PI * ((double)k + 0.05 * step * (double)nfft / (double)n) / (double)nfft;
-    double sxr = 0.0, sxi = 0.0, sdd = 0.0;
-    for (size_t j = k - m; j <= k + m; ++j) {
-      double dr, di;
-      dirichlet(2.0 * HM_PI * (double)j / (double)nfft - wl, n, &dr, &di);
-      sxr += re[j] * dr + im[j] * di; /* X conj(D) */
-      sxi += im[j] * dr - re[j] * di;
-      sdd += dr * dr + di * di;
-    }
-    if (sdd > 0.0) explained = fmax(explained, (sxr * sxr + sxi * sxi) / sdd);
+/* The line at frequency wl [rad per sample] fitted over bins k-m..k+m: its complex amplitude and the power it
+ * explains (-1 if D vanishes there). */
+static double line_at(const double *re, const double *im, size_t k, size_t m, size_t n, size_t nfft, double wl,
+                      double *ar, double *ai) {
+  double sxr = 0.0, sxi = 0.0, sdd = 0.0;
+  for (size_t j = k - m; j <= k + m; ++j) {
+    double dr, di;
+    dirichlet(2.0 * HM_PI * (double)j / (double)nfft - wl, n, &dr, &di);
+    sxr += re[j] * dr + im[j] * di; /* X conj(D) */
+    sxi += im[j] * dr - re[j] * di;
+    sdd += dr * dr + di * di;
   }
+  if (!(sdd > 0.0)) return -1.0;
+  *ar = sxr / sdd;
+  *ai = sxi / sdd;
+  return (sxr * sxr + sxi * sxi) / sdd;
+}
+
+hm_status hm_lines_fit_sinusoid(const double *re, const double *im, size_t nbins, size_t k, size_t n, size_t nfft,
+                                hm_lines_sinusoid *out) {
+  if (!re || !im || !out || n < 4 || nfft < n || k >= nbins) return HM_EINVAL;
+  const size_t m = (size_t)ceil(3.0 * (double)nfft / (double)n); /* -+3 bins per 1 / T */
+  if (k < m || k + m >= nbins) return HM_EINVAL;
+  double total = 0.0;
+  for (size_t j = k - m; j <= k + m; ++j) total += re[j] * re[j] + im[j] * im[j];
+  /* the frequency: a grid of 1/20 of 1 / T over -+0.6 of it about the bin, then of 1/200 about the best point, then
+   * the parabola through the best three (the subtraction of a line 40 dB above the continuum needs it to 1e-3) */
+  const double unit = 2.0 * HM_PI * (double)nfft / (double)n / (double)nfft; /* 1 / T in rad per sample */
+  const double w_bin = 2.0 * HM_PI * (double)k / (double)nfft;
+  double best_w = w_bin, best = -1.0, ar, ai;
+  for (int step = -12; step <= 12; ++step) {
+    const double w = w_bin + 0.05 * step * unit, e = line_at(re, im, k, m, n, nfft, w, &ar, &ai);
+    if (e > best) best = e, best_w = w;
+  }
+  const double h = 0.005 * unit;
+  double ew[21];
+  int ib = 10;
+  for (int step = -10; step <= 10; ++step) {
+    ew[step + 10] = line_at(re, im, k, m, n, nfft, best_w + step * h, &ar, &ai);
+    if (ew[step + 10] > ew[ib]) ib = step + 10;
+  }
+  double w = best_w + (ib - 10) * h;
+  if (ib > 0 && ib < 20) {
+    const double den = ew[ib - 1] - 2.0 * ew[ib] + ew[ib + 1];
+    if (den < 0.0) w += 0.5 * h * (ew[ib - 1] - ew[ib + 1]) / den;
+  }
+  const double explained = line_at(re, im, k, m, n, nfft, w, &ar, &ai);
+  if (explained < 0.0) return HM_EINVAL;
   const double residual = total - explained, dof = 2.0 * (double)(2 * m + 1) - 2.0;
-  return residual > 0.0 ? (explained / 2.0) / (residual / dof) : INFINITY;
+  out->omega = w;
+  out->amp_re = ar;
+  out->amp_im = ai;
+  out->f_stat = residual > 0.0 ? (explained / 2.0) / (residual / dof) : INFINITY;
+  return HM_OK;
+}
+
+void hm_lines_subtract(double *re, double *im, size_t k_lo, size_t k_hi, size_t n, size_t nfft,
+                       const hm_lines_sinusoid *line) {
+  if (!re || !im || !line || n == 0 || nfft == 0) return;
+  for (size_t j = k_lo; j <= k_hi; ++j) {
+    double dr, di;
+    dirichlet(2.0 * HM_PI * (double)j / (double)nfft - line->omega, n, &dr, &di);
+    re[j] -= line->amp_re * dr - line->amp_im * di; /* A D */
+    im[j] -= line->amp_re * di + line->amp_im * dr;
+  }
 }

@@ -119,6 +119,18 @@ const char *hm_narrow_verdict_text(hm_narrow_verdict v) {
   return "?";
 }
 
+void hm_margin_shift_time(hm_margin m, double delta_s) {
+  if (!m || !isfinite(delta_s)) return;
+  for (size_t k = 0; k < m->n; ++k) m->w[(m->head + HM_MARGIN_MAX_WINDOWS - 1 - k) % HM_MARGIN_MAX_WINDOWS].t_end_s += delta_s;
+  for (size_t k = 0; k < m->misfit_n; ++k) m->misfit_t[k] += delta_s;
+  m->pending.t_end_s += delta_s;
+  m->pending_misfit_t += delta_s;
+  m->last_end_s += delta_s;
+  if (m->n_changes) m->last_change_s += delta_s;
+  if (m->narrow_at_s != 0.0) m->narrow_at_s += delta_s;
+  if (m->ambiguous_at_s != 0.0) m->ambiguous_at_s += delta_s;
+}
+
 hm_narrow_verdict hm_margin_last_narrow(const hm_margin m) { return m ? m->narrow : HM_NARROW_NONE; }
 
 void hm_margin_set_prior(hm_margin m, double conicity_low, double conicity_high) {
@@ -199,17 +211,38 @@ static hm_window_verdict prepare_reading(const hm_margin m, double t_end, double
 static void model_based(const hm_margin m, const window *const *ws, size_t n, hm_margin_estimate *r);
 static size_t held(const hm_margin m, double now, const window **ws);
 
-/* A window's conicity that what is known supports: within change_z combined standard errors of the windows held,
- * or without any, the prior's range within interval_z of its error (or no prior given). */
-static int supported(const hm_margin m, const window *w) {
+/* What is known of the conicity at a window's end: the windows held (their estimate), else the prior's range. */
+static void known(const hm_margin m, double t_end, double *lo, double *hi, double *se, int *from_windows) {
   const window *ws[HM_MARGIN_MAX_WINDOWS];
-  const size_t n = held(m, w->t_end_s, ws);
+  const size_t n = held(m, t_end, ws);
   hm_margin_estimate r;
   memset(&r, 0, sizeof r);
   model_based(m, ws, n, &r);
-  if (r.conicity_valid) return fabs(w->lambda - r.conicity) <= m->cfg.change_z * hypot(w->lambda_se, r.conicity_se);
+  *from_windows = r.conicity_valid;
+  *lo = *hi = r.conicity;
+  *se = r.conicity_se;
+  if (!r.conicity_valid) *lo = m->prior_low, *hi = m->prior_high, *se = 0.0;
+}
+
+/* A window's conicity that what is known supports: within change_z combined standard errors of the windows held,
+ * or without any, the prior's range within interval_z of its error (or no prior given). */
+static int supported(const hm_margin m, const window *w) {
+  double lo, hi, se;
+  int from_windows;
+  known(m, w->t_end_s, &lo, &hi, &se, &from_windows);
+  if (from_windows) return fabs(w->lambda - lo) <= m->cfg.change_z * hypot(w->lambda_se, se);
   const double z = m->cfg.interval_z * w->lambda_se;
-  return m->prior_high <= 0.0 || (w->lambda + z >= m->prior_low && w->lambda - z <= m->prior_high);
+  return hi <= 0.0 || (w->lambda + z >= lo && w->lambda - z <= hi);
+}
+
+/* A window's conicity above what is known (beyond change_z combined errors of the windows held, or interval_z of its
+ * own above the prior's range): its Hopf speed lower, the cautious direction. */
+static int cautious(const hm_margin m, const window *w) {
+  double lo, hi, se;
+  int from_windows;
+  known(m, w->t_end_s, &lo, &hi, &se, &from_windows);
+  if (from_windows) return w->lambda - hi > m->cfg.change_z * hypot(w->lambda_se, se);
+  return hi > 0.0 && w->lambda - m->cfg.interval_z * w->lambda_se > hi;
 }
 
 /* A window's checks and inversion into *w. A narrow peak (modal.h) is the hunting mode near its Hopf speed when the
@@ -231,7 +264,9 @@ static hm_window_verdict prepare(const hm_margin m, double t_end, double speed_k
       prepare_reading(m, t_end, speed_kmh, spread_kmh, mode->window_s, &mode->line_reading, &wl);
   const int impossible = v == HM_WINDOW_MISFIT || v == HM_WINDOW_NO_INVERSION;
   const int beside = primary.poles == 2 || fabs(mode->line_reading.frequency_hz - primary.frequency_hz) > 1.0;
-  if (vl == HM_WINDOW_USED && (impossible || beside) && supported(m, &wl)) {
+  /* the mode beside it, where what is known supports it, or where it is the cautious reading (wheels worn beyond the
+   * prior: it lowers the interval, alarm.h) */
+  if (vl == HM_WINDOW_USED && (impossible || beside) && (supported(m, &wl) || cautious(m, &wl))) {
     *w = wl;
     return *narrow = HM_NARROW_LINE, vl;
   }

@@ -261,11 +261,12 @@ void hm_mode_estimate_reading(const hm_mode_estimate *e, hm_mode_reading *r) {
   r->iterations = e->iterations;
 }
 
-/* One window's geometry: its band bins k0..k1, bin spacing, length, the periodogram's reference frequency and the
- * padding's factor nfft / n. */
+/* One window's geometry: its band bins k0..k1, bin spacing, length, the periodogram's reference frequency, the
+ * padding's factor nfft / n and the speed's relative range. */
 typedef struct {
   size_t k0, k1;
   double df, T, w_ref, padding;
+  double spread_rel; /* the window's speed range over its mean: a track line moves over that share of its frequency */
 } window_geometry;
 
 /* The band's bins not marked in mask (NULL: all) into m->w, u, pgram, scaled to mean 1 (*scale the factor); their
@@ -455,28 +456,42 @@ static int narrow_on(const window_geometry *g, const hm_mode_reading *r, double 
          fabs(f_hz - r->frequency_hz) <= 1.5 / g->T + 2.0 * r->frequency_se_hz;
 }
 
-/* Which of the lone candidates in the band are sinusoids (lines.h's harmonic F test at HM_MODAL_LINE_F or more): their indices in lr into idx; their count. */
+/* Which of the lone candidates in the band are sinusoids (lines.h's harmonic F test at HM_MODAL_LINE_F or more):
+ * their indices in lr into idx, their fitted lines into fits and their local backgrounds into bgs; their count. */
 static unsigned sinusoids(const hm_modal m, const window_geometry *g, const hm_lines_result *lr, size_t n,
-                          unsigned *idx) {
+                          unsigned *idx, hm_lines_sinusoid *fits, double *bgs) {
   unsigned count = 0;
   for (unsigned j = 0; j < lr->n_lone; ++j) {
     const size_t k = lr->lone_bin[j];
     if (k < g->k0 || k > g->k1 || m->set_aside[k]) continue;
-    const double f = hm_lines_sinusoid_f(m->re, m->im, m->nfft / 2 + 1, k, n, m->nfft);
-    if (f >= HM_MODAL_LINE_F) idx[count++] = j;
+    hm_lines_sinusoid fit;
+    if (hm_lines_fit_sinusoid(m->re, m->im, m->nfft / 2 + 1, k, n, m->nfft, &fit) != HM_OK) continue;
+    if (fit.f_stat >= HM_MODAL_LINE_F) idx[count] = j, bgs[count] = m->power[k] / lr->lone_ratio[j], fits[count++] = fit;
   }
   return count;
 }
 
-/* Set line j of lr aside and list it in e. */
-static void set_line_aside(hm_modal m, const window_geometry *g, const hm_lines_result *lr, unsigned j, size_t n,
+/* Set a line aside: its fitted sinusoid subtracted from the band's DFT (the power there recomputed), and the bins
+ * its residue still stands above the continuum in left out (its main lobe, -+2 / T, for a line the subtraction
+ * removed; as wide as a line of that residue's strength leaks, lines.h, for one whose frequency moved in the window);
+ * listed in e. bg: the line's local background (|X|^2 of the continuum there). */
+static void set_line_aside(hm_modal m, const window_geometry *g, const hm_lines_sinusoid *fit, double bg, size_t n,
                            hm_mode_estimate *e) {
-  hm_lines_mark(m->lines, lr->lone_hz[j], lr->lone_ratio[j], m->nfft / 2 + 1, g->df, g->T, m->set_aside);
+  const double f = fit->omega * m->fd / (2.0 * HM_PI);
   if (e->lone_lines < HM_MODAL_MAX_LONE) {
-    e->lone_line_hz[e->lone_lines] = lr->lone_hz[j];
-    /* a sinusoid of amplitude A over n samples has |X| = A n / 2 at its bin */
-    e->lone_line_mps2[e->lone_lines++] = 2.0 * sqrt(m->power[lr->lone_bin[j]]) / (double)n;
+    e->lone_line_hz[e->lone_lines] = f;
+    /* a sinusoid of amplitude A over n samples has |X| = A n / 2 at its bin: |amp| = A / 2 */
+    e->lone_line_mps2[e->lone_lines++] = 2.0 * hypot(fit->amp_re, fit->amp_im);
   }
+  hm_lines_subtract(m->re, m->im, g->k0, g->k1, n, m->nfft, fit);
+  double residue = 0.0;
+  const size_t kc = (size_t)llround(f / g->df), h = (size_t)ceil(2.0 * g->padding);
+  for (size_t k = g->k0; k <= g->k1; ++k) {
+    m->power[k] = m->re[k] * m->re[k] + m->im[k] * m->im[k];
+    if (k + h >= kc && k <= kc + h) residue = fmax(residue, m->power[k]);
+  }
+  hm_lines_mark(m->lines, f, bg > 0.0 ? residue / bg : 1.0, g->spread_rel, m->nfft / 2 + 1, g->df, g->T,
+                m->set_aside);
 }
 
 /* The window's periodogram (m->power, every bin) from the newest n decimated samples, oldest first, without their
@@ -492,9 +507,10 @@ static void periodogram(hm_modal m, size_t n) {
 }
 
 /* The comb of lines (lines.h) into r's fields and m->excluded; the search's result in *lr. */
-static void find_comb(hm_modal m, size_t n, double df, double T, hm_lines_result *lr, hm_mode_estimate *r) {
+static void find_comb(hm_modal m, size_t n, double df, double T, double spread_rel, hm_lines_result *lr,
+                      hm_mode_estimate *r) {
   const size_t nbins = m->nfft / 2 + 1;
-  if (hm_lines_find(m->lines, m->power, nbins, df, T, 2.5, 0.3 * m->fd, m->excluded, lr) != HM_OK) {
+  if (hm_lines_find(m->lines, m->power, nbins, df, T, 2.5, 0.3 * m->fd, spread_rel, m->excluded, lr) != HM_OK) {
     memset(lr, 0, sizeof *lr);
     memset(m->excluded, 0, nbins);
   }
@@ -510,7 +526,7 @@ static void find_comb(hm_modal m, size_t n, double df, double T, hm_lines_result
   memcpy(m->set_aside, m->excluded, nbins);
 }
 
-hm_status hm_modal_fit(hm_modal m, double max_window_s, hm_mode_estimate *out) {
+hm_status hm_modal_fit(hm_modal m, double max_window_s, double speed_spread_rel, hm_mode_estimate *out) {
   if (!m || !out || !(max_window_s > 0.0)) return HM_EINVAL;
   m->since_fit = 0;
   hm_mode_estimate r;
@@ -527,10 +543,11 @@ hm_status hm_modal_fit(hm_modal m, double max_window_s, hm_mode_estimate *out) {
   g.T = r.window_s;
   g.w_ref = 2.0 * HM_PI * 0.5 * (m->cfg.band_low_hz + m->cfg.band_high_hz);
   g.padding = (double)m->nfft / (double)n;
+  g.spread_rel = isfinite(speed_spread_rel) && speed_spread_rel > 0.0 ? speed_spread_rel : 0.0;
   g.k0 = (size_t)ceil(m->cfg.band_low_hz / g.df);
   g.k1 = (size_t)fmin(floor(m->cfg.band_high_hz / g.df), (double)(m->nfft / 2));
   hm_lines_result lr;
-  find_comb(m, n, g.df, g.T, &lr, &r);
+  find_comb(m, n, g.df, g.T, g.spread_rel, &lr, &r);
   /* the window's reading, without the comb; then without the lone lines it does not explain */
   double scale, th[NPM];
   unsigned poles;
@@ -545,12 +562,14 @@ hm_status hm_modal_fit(hm_modal m, double max_window_s, hm_mode_estimate *out) {
   /* lone lines (sinusoids among the lone candidates): set aside, but for one the mode sits on while as narrow as a
    * line, which is the narrow-peak question (modal.h) */
   unsigned lines[HM_LINES_MAX_LONE];
-  const unsigned n_lines = sinusoids(m, &g, &lr, n, lines);
+  hm_lines_sinusoid fits[HM_LINES_MAX_LONE];
+  double bgs[HM_LINES_MAX_LONE];
+  const unsigned n_lines = sinusoids(m, &g, &lr, n, lines, fits, bgs);
   int narrow = -1;
   for (unsigned i = 0; i < n_lines; ++i)
-    if (narrow < 0 && narrow_on(&g, &rd, lr.lone_hz[lines[i]])) narrow = (int)lines[i];
+    if (narrow < 0 && narrow_on(&g, &rd, lr.lone_hz[lines[i]])) narrow = (int)i;
   for (unsigned i = 0; i < n_lines; ++i)
-    if ((int)lines[i] != narrow) set_line_aside(m, &g, &lr, lines[i], n, &r);
+    if ((int)i != narrow) set_line_aside(m, &g, &fits[i], bgs[i], n, &r);
   if (n_lines > (narrow >= 0 ? 1u : 0u)) {
     nb = load_bins(m, &g, m->set_aside, &scale);
     if (nb < 4 * HM_WHITTLE_NP2 || !fit_reading(m, &m->warm[0], &g, nb, &rd, th, &poles)) {
@@ -561,11 +580,13 @@ hm_status hm_modal_fit(hm_modal m, double max_window_s, hm_mode_estimate *out) {
   size_t n_band = 0, n_out = 0;
   for (size_t k = g.k0; k <= g.k1; ++k) ++n_band, n_out += m->set_aside[k] != 0;
   r.band_excluded_fraction = n_band ? (double)n_out / (double)n_band : 0.0;
-  if (narrow >= 0) { /* the reading with that line left out too */
+  if (narrow >= 0) { /* the reading with that line set aside too */
     r.narrow_peak = 1;
-    r.narrow_peak_hz = lr.lone_hz[narrow];
-    r.narrow_peak_mps2 = 2.0 * sqrt(m->power[lr.lone_bin[narrow]]) / (double)n;
-    hm_lines_mark(m->lines, lr.lone_hz[narrow], lr.lone_ratio[narrow], m->nfft / 2 + 1, g.df, g.T, m->set_aside);
+    r.narrow_peak_hz = fits[narrow].omega * m->fd / (2.0 * HM_PI);
+    r.narrow_peak_mps2 = 2.0 * hypot(fits[narrow].amp_re, fits[narrow].amp_im);
+    const unsigned listed = r.lone_lines;
+    set_line_aside(m, &g, &fits[narrow], bgs[narrow], n, &r);
+    r.lone_lines = listed; /* the narrow peak is reported as such, not as a lone line */
     double th_l[NPM];
     unsigned poles_l;
     const size_t nb_l = load_bins(m, &g, m->set_aside, &scale);

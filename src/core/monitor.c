@@ -144,6 +144,7 @@ hm_status hm_monitor_create_parallel(const hm_monitor_config *cfg, const hm_vehi
   }
   hm_alarm_set_displacement_limit(m->alarm, cfg->estimator.displacement_limit_m);
   hm_alarm_set_measurement_point(m->alarm, cfg->estimator.measurement_point);
+  hm_alarm_set_memory(m->alarm, cfg->margin.memory_s);
   share_prior(m);
   m->modal_ok = 1;
   m->verdict = HM_WINDOW_MODE_INVALID; /* no fit yet */
@@ -167,18 +168,35 @@ void hm_monitor_destroy(hm_monitor m) {
   free(m);
 }
 
-void hm_monitor_reset(hm_monitor m) {
-  if (!m) return;
+/* The stream restarts: estimator, identification and the steady stretch's speed chunks. */
+static void restart_input(hm_monitor m) {
   hm_estimator_reset(m->est);
   m->modal_ok = hm_modal_set_rate(m->modal, m->cfg.estimator.sample_rate_hz) == HM_OK;
   m->restarts = hm_estimator_restarts(m->est, &m->rate_hz);
   m->have_speed = 0;
   memset(&m->mode, 0, sizeof m->mode);
   m->verdict = HM_WINDOW_MODE_INVALID;
+  restart_stream(m);
+}
+
+void hm_monitor_reset(hm_monitor m) {
+  if (!m) return;
+  restart_input(m);
   hm_margin_reset(m->margin); /* its windows' times are on the old time line */
   m->large_at = -INFINITY;
-  restart_stream(m);
-  hm_alarm_reset(m->alarm);
+  hm_alarm_restart(m->alarm); /* a held ALARM stays held: a latch carries no times that matter */
+}
+
+void hm_monitor_time_jump(hm_monitor m, double delta_s) {
+  if (!m) return;
+  if (!isfinite(delta_s)) {
+    hm_monitor_reset(m);
+    return;
+  }
+  restart_input(m);
+  hm_margin_shift_time(m->margin, delta_s);
+  m->large_at += delta_s;
+  hm_alarm_shift_time(m->alarm, delta_s);
 }
 
 /* A fit of the identification. At a steady speed (the newest stretch whose speed varied by at most the margin's
@@ -220,7 +238,9 @@ static void fit(hm_monitor m, double t) {
   const double fresh = is_steady ? fmin(steady.duration_s, t - m->committed_until) : 0.0;
   const int for_margin = fresh >= mc->min_window_s;
   hm_mode_estimate e;
-  if (hm_modal_fit(m->modal, for_margin ? fresh : mc->window_s, &e) != HM_OK) {
+  const double spread_rel =
+      is_steady && steady.n > 0.0 && steady.sum > 0.0 ? (steady.max - steady.min) / (steady.sum / steady.n) : 0.0;
+  if (hm_modal_fit(m->modal, for_margin ? fresh : mc->window_s, spread_rel, &e) != HM_OK) {
     m->mode.valid = 0;
     return;
   }

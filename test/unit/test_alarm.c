@@ -122,6 +122,35 @@ static void stale_input_is_no_data(void) {
   hm_alarm_update(a, &e, NULL, 0.3, &s);
   HM_CHECK(s.level == HM_LEVEL_OK && s.changed, "data back: %s", hm_level_name(s.level));
   hm_alarm_destroy(a);
+  /* a held ALARM (the r.m.s. criterion at 470 km/h) through 20 s of stale acceleration (the sensor lost to violent
+   * hunting, issue #27): ALARM, latched, with its cause, the margins not current; then a restarted time line (a
+   * clock step): still held; data back and calm below the interval: released after release_s (10 s) of it */
+  a = make();
+  e = estimate(470.0, 2.5e-3);
+  e.rms_exceeded = 1;
+  hm_alarm_update(a, &e, NULL, 0.0, &s);
+  HM_CHECK(s.level == HM_LEVEL_ALARM && s.latched, "latched");
+  e.accel_valid = e.oscillation_valid = e.rms_exceeded = 0;
+  int held = 1;
+  for (int k = 1; k <= 200; ++k) {
+    hm_alarm_update(a, &e, NULL, 0.1 * k, &s);
+    held &= s.level == HM_LEVEL_ALARM && s.latched && s.reason == HM_REASON_RMS_CRITERION && !s.boundaries_valid &&
+            s.release_in_s == 10.0;
+  }
+  HM_CHECK(held, "stale while latched: %s (%s), latched %d, boundaries %d", hm_level_name(s.level),
+           hm_reason_text(s.reason), s.latched, s.boundaries_valid);
+  hm_alarm_restart(a);
+  e = estimate(440.0, 0.3e-3);
+  hm_alarm_update(a, &e, NULL, 1000.0, &s); /* another time line */
+  HM_CHECK(s.level == HM_LEVEL_ALARM && s.latched && s.reason == HM_REASON_RMS_CRITERION && s.hopf_low_kmh == 470.0,
+           "after a restart: %s latched %d, low end %.1f", hm_level_name(s.level), s.latched, s.hopf_low_kmh);
+  double released = -1.0;
+  for (int k = 1; k <= 150 && released < 0.0; ++k) {
+    hm_alarm_update(a, &e, NULL, 1000.0 + 0.1 * k, &s);
+    if (!s.latched) released = 0.1 * k;
+  }
+  HM_CHECK_DELTA(released, 10.1, 0.11, "released after 10 s of calm with data");
+  hm_alarm_destroy(a);
 }
 
 /* Hysteresis and hold: from ALARM (above Hopf) down to 3 km/h below it the level stays ALARM; further down it
@@ -230,8 +259,10 @@ static void oscillation_alarm_latches(void) {
                s.release_in_s == 10.0,
            "calm at the hunting speed: %s, latched %d, low end %.1f (from hunting %d), release in %g s",
            hm_level_name(s.level), s.latched, s.hopf_low_kmh, s.hopf_low_from_hunting, s.release_in_s);
-  /* calm at 466 km/h (below 470 by more than the 3 km/h hysteresis): released after 10 s, lowered 3 s later, the
-   * interval the model's again */
+  /* calm at 466 km/h (below 470 by more than the 3 km/h hysteresis): released after 10 s, lowered 3 s later to WARN:
+   * the vehicle hunted at 470 km/h, a one-sided bound on its Hopf (or fold) speed for memory_s (900 s by default,
+   * issue #27), WARN from it less the 10 km/h margin; back at 470 km/h still WARN (it was WATCH before: the
+   * interval forgot the hunting); after the memory, the model's interval again and OK at 466 km/h */
   double released = -1.0, lowered = -1.0;
   for (int k = 1; k <= 200; ++k) {
     const double t = 60.0 + 0.1 * k;
@@ -243,8 +274,17 @@ static void oscillation_alarm_latches(void) {
   }
   HM_CHECK_DELTA(released, 60.1 + 10.0, 0.11, "released after 10 s of calm");
   HM_CHECK_DELTA(lowered, 60.1 + 13.0, 0.11, "lowered after the 3 s hold");
-  HM_CHECK(s.level == HM_LEVEL_OK && !s.hopf_low_from_hunting && s.hopf_low_kmh > 500.0,
-           "level after release: %s, low end %.1f", hm_level_name(s.level), s.hopf_low_kmh);
+  HM_CHECK(s.level == HM_LEVEL_WARN && s.reason == HM_REASON_NEAR_HOPF && s.hopf_low_from_hunting &&
+               s.hopf_low_kmh == 470.0 && s.hunted_at_kmh == 470.0 && s.warn_from_kmh == 460.0,
+           "level after release: %s, low end %.1f (from hunting %d), WARN from %.1f", hm_level_name(s.level),
+           s.hopf_low_kmh, s.hopf_low_from_hunting, s.warn_from_kmh);
+  e = estimate(470.0, 0.5e-3);
+  hm_alarm_update(a, &e, NULL, 81.0, &s);
+  HM_CHECK(s.level == HM_LEVEL_WARN && !s.latched, "back at 470 km/h: %s", hm_level_name(s.level));
+  e = estimate(466.0, 0.5e-3);
+  for (int k = 0; k <= 50; ++k) hm_alarm_update(a, &e, NULL, 81.0 + 900.0 + 0.1 * k, &s);
+  HM_CHECK(s.level == HM_LEVEL_OK && !s.hopf_low_from_hunting && s.hopf_low_kmh > 500.0 && isnan(s.hunted_at_kmh),
+           "after memory_s: %s, low end %.1f", hm_level_name(s.level), s.hopf_low_kmh);
   hm_alarm_destroy(a);
   /* calm oscillation but the speed inside the Hopf interval: held */
   a = make();
@@ -677,7 +717,7 @@ int main(void) {
   HM_RUN(oscillation_alarm_latches);
   HM_RUN(bad_configuration_and_input);
   HM_RUN(anticipates_a_sustained_acceleration);
-  hm_table_destroy(table);
   HM_RUN(what_the_model_may_not_explain);
+  hm_table_destroy(table);
   HM_TEST_EXIT();
 }

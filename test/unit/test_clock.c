@@ -207,7 +207,45 @@ static void bad_input(void) {
   HM_CHECK(hm_clock_init(&d, &cfg) == HM_EDOMAIN && d.n_steps == 0x5a5a5a5a5a5a5a5aul, "untouched on failure");
 }
 
+/* Delivery stalls of 2 and 5 s (issue #27) at 2 kHz: nothing arrives, then the backlog drains at twice real time
+ * (every sample of the stall, its stamps continuous, up to 5 s late): never a step, every sample used, the offset
+ * (ROS time - stamp, 1 ms) unchanged to 1e-12. A receiver clock stepped back by 0.5 s (an NTP correction) and the
+ * offset shifted with it (hm_clock_shift): the next samples are used, no step, the offset 0.5 s lower. */
+static void stalls_are_not_steps(void) {
+  const double stalls[] = {2.0, 5.0};
+  for (int i = 0; i < 2; ++i) {
+    hm_clock c = make();
+    hm_clock_verdict v;
+    unsigned long used = 0, n = 0;
+    double receipt = 0.0;
+    const double fs = 2000.0;
+    for (long k = 0; k < (long)(30.0 * fs); ++k) {
+      const double stamp = k / fs, t_stall = 10.0;
+      /* before the stall: received 1 ms after the stamp; during it nothing; after it the backlog at 2x real time */
+      receipt = stamp < t_stall ? stamp + 1e-3 : fmax(stamp + 1e-3, t_stall + stalls[i] + 0.5 * (stamp - t_stall));
+      HM_CHECK(hm_clock_observe(&c, stamp, receipt, &v) == HM_OK, "observe");
+      ++n;
+      used += v == HM_CLOCK_USE;
+    }
+    HM_CHECK(used == n && c.n_steps == 0, "%g s stall: %lu of %lu used, %lu steps", stalls[i], used, n, c.n_steps);
+    HM_CHECK_DELTA(c.offset_s, 1e-3, 1e-12, "offset after the stall");
+    printf("  %.0f s stall: %lu of %lu samples used, %lu late, no step\n", stalls[i], used, n, c.n_late);
+  }
+  hm_clock c = make();
+  hm_clock_verdict v;
+  for (long k = 0; k < 4000; ++k) hm_clock_observe(&c, k / 2000.0, k / 2000.0 + 1e-3, &v);
+  hm_clock_shift(&c, -0.5);
+  unsigned long used = 0;
+  for (long k = 4000; k < 8000; ++k) {
+    hm_clock_observe(&c, k / 2000.0, k / 2000.0 + 1e-3 - 0.5, &v);
+    used += v == HM_CLOCK_USE;
+  }
+  HM_CHECK(used == 4000 && c.n_steps == 0, "after the receiver's step: %lu used, %lu steps", used, c.n_steps);
+  HM_CHECK_DELTA(c.offset_s, 1e-3 - 0.5, 1e-12, "offset after the receiver's step");
+}
+
 int main(void) {
+  HM_RUN(stalls_are_not_steps);
   HM_RUN(offset_follows_the_clocks);
   HM_RUN(delivery_delays_and_losses);
   HM_RUN(steps_of_the_clock);

@@ -49,7 +49,7 @@ static void comb_of_joints(void) {
   for (int m = 1; m <= 6; ++m) f[m - 1] = m * f1, a[m - 1] = 0.3 - 0.03 * (m - 1);
   spectrum_of(f, a, 6);
   hm_lines_result r;
-  HM_CHECK(hm_lines_find(l, power, N / 2 + 1, FS / N, T, 2.5, 30.0, excl, &r) == HM_OK, "find");
+  HM_CHECK(hm_lines_find(l, power, N / 2 + 1, FS / N, T, 2.5, 30.0, 0.0, excl, &r) == HM_OK, "find");
   HM_CHECK(r.found && r.harmonics >= 5, "comb found %d with %u harmonics (%u candidates)", r.found, r.harmonics,
            r.candidates);
   HM_CHECK_DELTA(r.fundamental_hz, f1, 2e-3, "fundamental");
@@ -72,14 +72,14 @@ static void single_lines_and_noise_are_not_combs(void) {
   hm_lines_result r;
   const double f_mode = 14.1, a_mode = 0.3;
   spectrum_of(&f_mode, &a_mode, 1);
-  HM_CHECK(hm_lines_find(l, power, N / 2 + 1, FS / N, T, 2.5, 30.0, excl, &r) == HM_OK && !r.found &&
+  HM_CHECK(hm_lines_find(l, power, N / 2 + 1, FS / N, T, 2.5, 30.0, 0.0, excl, &r) == HM_OK && !r.found &&
                r.bins_excluded == 0 && r.candidates >= 1,
            "one line: found %d, %u candidates", r.found, r.candidates);
   int combs = 0;
   unsigned candidates = 0;
   for (int s = 0; s < 20; ++s) {
     spectrum_of(NULL, NULL, 0);
-    hm_lines_find(l, power, N / 2 + 1, FS / N, T, 2.5, 30.0, excl, &r);
+    hm_lines_find(l, power, N / 2 + 1, FS / N, T, 2.5, 30.0, 0.0, excl, &r);
     combs += r.found;
     candidates += r.candidates;
   }
@@ -87,7 +87,7 @@ static void single_lines_and_noise_are_not_combs(void) {
   printf("  noise: %u chance candidates in 20 spectra of 2750 bins (exp(-8) x 2750 = 0.9 each), no comb\n", candidates);
   const double f[] = {6.0, 12.0, 18.0, 24.0, 9.7, 21.3}, a[] = {0.25, 0.25, 0.25, 0.25, 0.25, 0.25};
   spectrum_of(f, a, 6);
-  hm_lines_find(l, power, N / 2 + 1, FS / N, T, 2.5, 30.0, excl, &r);
+  hm_lines_find(l, power, N / 2 + 1, FS / N, T, 2.5, 30.0, 0.0, excl, &r);
   HM_CHECK(r.found && fabs(r.fundamental_hz - 6.0) < 2e-3, "fundamental %g, not a sub-harmonic", r.fundamental_hz);
   hm_lines_destroy(l);
 }
@@ -108,11 +108,11 @@ static void bad_configuration_and_input(void) {
   hm_lines_result r;
   memset(&r, 0x5a, sizeof r);
   const hm_lines_result before = r;
-  HM_CHECK(hm_lines_find(l, power, N, FS / N, T, 2.5, 30.0, excl, &r) == HM_EINVAL &&
+  HM_CHECK(hm_lines_find(l, power, N, FS / N, T, 2.5, 30.0, 0.0, excl, &r) == HM_EINVAL &&
                memcmp(&r, &before, sizeof r) == 0,
            "more bins than created for");
-  HM_CHECK(hm_lines_find(l, power, N / 2 + 1, 0.0, T, 2.5, 30.0, excl, &r) == HM_EINVAL, "zero bin width");
-  HM_CHECK(hm_lines_find(l, NULL, N / 2 + 1, FS / N, T, 2.5, 30.0, excl, &r) == HM_EINVAL, "NULL power");
+  HM_CHECK(hm_lines_find(l, power, N / 2 + 1, 0.0, T, 2.5, 30.0, 0.0, excl, &r) == HM_EINVAL, "zero bin width");
+  HM_CHECK(hm_lines_find(l, NULL, N / 2 + 1, FS / N, T, 2.5, 30.0, 0.0, excl, &r) == HM_EINVAL, "NULL power");
   hm_lines_destroy(l);
 }
 

@@ -61,7 +61,7 @@ static void decay_rate_of_a_known_oscillator(void) {
         hm_modal_push(m, a + sensor * hm_test_gauss());
       }
       hm_mode_estimate e;
-      HM_CHECK(hm_modal_fit(m, 40.0, &e) == HM_OK && e.valid, "sigma %g window %d: fit (valid %d)", sigmas[i], win,
+      HM_CHECK(hm_modal_fit(m, 40.0, 0.0, &e) == HM_OK && e.valid, "sigma %g window %d: fit (valid %d)", sigmas[i], win,
                e.valid);
       if (!e.valid) continue;
       ++n;
@@ -97,7 +97,7 @@ static void rates_and_no_mode(void) {
     if (!m) return;
     for (long k = 0; k < (long)(40.0 * fs); ++k) hm_modal_push(m, sdof_step(&s, 1000.0 * hm_test_gauss(), 1.0 / fs));
     hm_mode_estimate e;
-    HM_CHECK(hm_modal_fit(m, 40.0, &e) == HM_OK && e.valid, "fit at %g Hz", fs);
+    HM_CHECK(hm_modal_fit(m, 40.0, 0.0, &e) == HM_OK && e.valid, "fit at %g Hz", fs);
     HM_CHECK_DELTA(e.decay_rate_1_s, -1.0, 4.0 * e.decay_rate_se_1_s, "decay rate");
     HM_CHECK_DELTA(e.frequency_hz, 12.0, 4.0 * e.frequency_se_hz + 1e-3, "frequency");
     HM_CHECK(hm_modal_set_rate(m, 1000.0) == HM_OK && !hm_modal_fit_due(m), "a new rate restarts");
@@ -108,7 +108,7 @@ static void rates_and_no_mode(void) {
   hm_modal_create(&c, 1000.0, &m, NULL, 0);
   for (long k = 0; k < 40000; ++k) hm_modal_push(m, hm_test_gauss());
   hm_mode_estimate e;
-  const hm_status st = hm_modal_fit(m, 40.0, &e);
+  const hm_status st = hm_modal_fit(m, 40.0, 0.0, &e);
   HM_CHECK(st == HM_ENOCONV || (st == HM_OK && !e.valid), "white noise taken for a mode: %g Hz, %g 1/s",
            e.frequency_hz, e.decay_rate_1_s);
   hm_modal_destroy(m);
@@ -148,7 +148,7 @@ static void joints_are_not_the_mode(void) {
         hm_modal_push(m, sdof_step(&s, 1000.0 * hm_test_gauss(), 1.0 / fs) + lines);
       }
       hm_mode_estimate e;
-      if (hm_modal_fit(m, 40.0, &e) != HM_OK || !e.valid) continue;
+      if (hm_modal_fit(m, 40.0, 0.0, &e) != HM_OK || !e.valid) continue;
       ++n;
       sum += e.decay_rate_1_s;
       sum_se += e.decay_rate_se_1_s;
@@ -222,7 +222,7 @@ static void coverage_of_the_intervals(void) {
           const double sensor = 0.1 * sqrt(ms);
           for (long k = 0; k < ns; ++k) hm_modal_push(m, buf[k] + sensor * hm_test_gauss());
           hm_mode_estimate e;
-          if (hm_modal_fit(m, T, &e) != HM_OK || !e.valid) continue;
+          if (hm_modal_fit(m, T, 0.0, &e) != HM_OK || !e.valid) continue;
           ++n;
           const double d = fabs(e.decay_rate_1_s - sg);
           in_stat += d <= 2.0 * e.decay_rate_se_1_s;
