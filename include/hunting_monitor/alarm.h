@@ -53,9 +53,10 @@
  * end included where it counts), an error independent of the margin's allowance:
  *   WATCH from point - sqrt(h^2 + watch_margin^2): the margin and the whole half-width in quadrature (the Hopf speed
  *         may lie that low: have it checked);
- *   WARN  from point - max(warn_margin, h / interval_z): the point less the margin, or less one standard error where
- *         that is larger (the speed then within the Hopf speed's likely range: about one chance in six that it is
- *         already at or above it).
+ *   WARN  from point - max(warn_margin, min(h / interval_z, HM_ALARM_WARN_MAX_BELOW_KMH)): the point less the margin,
+ *         or less one standard error where that is larger, up to 20 km/h (the speed then within the Hopf speed's
+ *         likely range: about one chance in six that it is already at or above it, more where the error exceeds
+ *         20 km/h; warn_risk says how much).
  * An estimate too uncertain to be used alone gives its own WARN threshold the same way, and the more cautious of it
  * and the prior's range (its lower end less the margin) counts (with model_mismatch: the combined range's lower end
  * less the margin). Why not the half-width for WARN too (in quadrature, as until this change, or linearly as before
@@ -171,6 +172,10 @@ typedef struct {
 #define HM_ALARM_ACCEL_BLOCK_S 2.5
 #define HM_ALARM_ACCEL_BLOCKS 4u
 #define HM_ALARM_MAX_ACCEL_KMH_S 1.0
+/* WARN below an identified point by one standard error, but not by more than this [km/h] (or the margin, if larger):
+ * from windows far below the Hopf speed one standard error reached 28 km/h and WARN came 23 km/h below the truth;
+ * WATCH keeps the whole half-width. The risk, Phi(-min(se, 20) / se), is in the status (warn_risk). */
+#define HM_ALARM_WARN_MAX_BELOW_KMH 20.0
 /* An estimate in use stays in use while its standard error is at most this times conicity_max_se. */
 #define HM_ALARM_SE_HYSTERESIS 1.25
 /* The model-free interval's lower end counts for the level from this many windows on (and with model_mismatch). */

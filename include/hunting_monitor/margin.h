@@ -9,7 +9,8 @@
  * its mode is valid, its speed varied by at most max_speed_spread_kmh, it is at min_speed_kmh or more, it does not
  * overlap the previous window used (so that the windows' errors are independent), and the model explains its decay
  * rate and frequency together (the inversion's misfit chi2, one degree of freedom, at most max_misfit_chi2: else the
- * window is a misfit, not used, and counted). Windows older than memory_s are forgotten (the wheels wear, the track
+ * window is a misfit, counted, and used for the model-free estimate only: its decay rate at its speed is still a
+ * measurement, whatever the model says of its frequency; so is a window no conicity explains). Windows older than memory_s are forgotten (the wheels wear, the track
  * changes).
  * Change: a new window (committed or provisional) whose conicity differs from the mean of those held by more than
  * change_z of their combined standard errors means the conicity changed (a worn section of rail, other wheels after a
@@ -66,6 +67,11 @@ extern "C" {
 #endif
 
 #define HM_MARGIN_MAX_WINDOWS 64
+/* A window whose decay rate is within this of zero [1/s] is near evidence (the alarm lets an estimate outside the
+ * prior, or a change's first window, set the interval only with it): 50 km/h below the default vehicle's Hopf speed
+ * the decay rate is -1.5..-2.5 1/s, 200 km/h below it -7..-25, where a bogie that is not the wheelset model read, by
+ * decay rate and frequency together, as a conicity of 0.34 for 0.19 (the campaign, issue #26). */
+#define HM_MARGIN_NEAR_DECAY_1_S 2.5
 
 typedef struct {
   double frequency_model_error;  /* relative error of the model's hunting frequency */
@@ -112,6 +118,8 @@ typedef struct {
   unsigned long n_changes;          /* changes of the conicity detected (the windows dropped each time) */
   double last_change_s;             /* when the last one was (0 if none) */
   unsigned windows_since_change;    /* windows held since it (the one that showed it included; n_windows if none) */
+  int near_evidence;                /* a window held measured a lightly damped mode (|sigma| at most
+                                       HM_MARGIN_NEAR_DECAY_1_S): instability is near, whatever the model says of it */
   int outside_prior;                /* the conicity's interval (-+ interval_z standard errors) lies wholly above (+1:
                                        the Hopf speed below the prior's range) or below (-1) the prior's range
                                        (hm_margin_set_prior), else 0 */

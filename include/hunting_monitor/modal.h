@@ -95,6 +95,10 @@ typedef struct {
   double second_frequency_hz, second_decay_rate_1_s; /* the other pair of two (0 with one) */
   double two_pair_lr;          /* 2 (L1 - L2) over the independent ordinates: two pairs are chosen above
                                   HM_MODAL_TWO_PAIR_LR (0 when the two-pair fit did not converge) */
+  double decay_rate_alt_1_s;   /* with one pair chosen but two telling a mode beside another resonance at a likelihood
+                                  ratio above HM_MODAL_TWO_PAIR_LR_WEAK: the two pairs' mode's decay rate (0: none).
+                                  The evidence cannot choose: the margin counts the difference as an error of the
+                                  decay rate (a broad resonance averaged with the mode reads it more damped) */
   double peak_core_z;          /* the periodogram's excess over the fit within half the mode's width of its frequency,
                                   in standard deviations: a narrower resonance inside the fitted peak (the mode
                                   beside a broad one, averaged with it) shows as a large positive value */
@@ -111,7 +115,7 @@ typedef struct {
   unsigned iterations;         /* scoring steps of this fit */
   int informative;             /* as in hm_mode_reading */
   unsigned poles;              /* as in hm_mode_reading */
-  double second_frequency_hz, second_decay_rate_1_s, two_pair_lr, peak_core_z;
+  double second_frequency_hz, second_decay_rate_1_s, two_pair_lr, peak_core_z, decay_rate_alt_1_s;
   /* a periodic excitation of the track found in the window (lines.h), whose bins the fit left out */
   int lines_found;
   double line_fundamental_hz;  /* the comb's spacing: V / L for a pattern every L metres */
@@ -137,9 +141,14 @@ typedef struct {
 /* A reading is informative when decay_rate_se <= HM_MODAL_INFORMATIVE_SE_1_S + HM_MODAL_INFORMATIVE_REL |sigma|. */
 #define HM_MODAL_INFORMATIVE_SE_1_S 0.5
 #define HM_MODAL_INFORMATIVE_REL 0.5
-/* Two pole pairs are chosen when 2 (L1 - L2), over the independent ordinates, exceeds this (the chi-square of three
- * more parameters beyond its 0.03% point: a lone pair with a chance second pair almost never). */
-#define HM_MODAL_TWO_PAIR_LR 12.0
+/* Two pole pairs are chosen when 2 (L1 - L2), over the independent ordinates, exceeds this: the three more parameters'
+ * chi-square beyond its 0.02% point, and about BIC's 3 ln(n) for the 600-700 bins of a band (the narrower pair may sit
+ * anywhere: at 12 a chance bump on a broad mode's flank was read as a mode of -0.6 1/s in 0.5% of single-pole windows
+ * and one such window of a campaign's ramp as a conicity change to 0.28). */
+#define HM_MODAL_TWO_PAIR_LR 20.0
+/* ... and between this and HM_MODAL_TWO_PAIR_LR (the chi-square's 5% point) the two pairs' mode is an alternative
+ * reading (decay_rate_alt_1_s). */
+#define HM_MODAL_TWO_PAIR_LR_WEAK 8.0
 
 /* The reading as the window's estimate (its fields copied; the window's lines kept), and the estimate's own reading. */
 void hm_mode_estimate_use_reading(hm_mode_estimate *e, const hm_mode_reading *r);

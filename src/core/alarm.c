@@ -359,7 +359,7 @@ static double sustained_acceleration(hm_alarm a, double now, double v_kmh) {
 /* WARN from an identified Hopf speed (alarm.h): the point less the larger of the margin and one standard error, the
  * lower half-width (point - low) being z of them. */
 static double warn_below_point(double point_kmh, double low_kmh, double margin_kmh, double z) {
-  return point_kmh - fmax(margin_kmh, (point_kmh - low_kmh) / z);
+  return point_kmh - fmax(margin_kmh, fmin((point_kmh - low_kmh) / z, HM_ALARM_WARN_MAX_BELOW_KMH));
 }
 
 /* The conicity in use, the Hopf interval and the boundaries at the current speed; the table's status on failure. */
@@ -368,9 +368,11 @@ static hm_status assess(hm_alarm a, const hm_estimate *e, const hm_margin_estima
   const int axle = a->point == HM_POINT_WHEELSET;
   const int have = c->use_conicity_estimate && g && g->conicity_valid && g->hopf_model_valid;
   /* the model-based interval counts from an axle-box sensor on a vehicle that behaves like its model (alarm.h) */
-  const int usable = have && axle && !g->model_mismatch;
+  const int usable_model = have && axle && !g->model_mismatch;
   const double max_se = a->precise ? HM_ALARM_SE_HYSTERESIS * c->conicity_max_se : c->conicity_max_se;
   const int unconfirmed_change = g && g->n_changes > 0 && g->windows_since_change < 2;
+  /* an estimate outside the prior, or a change's first window, enters only with a window near its Hopf speed */
+  const int usable = usable_model && (!(g->outside_prior || unconfirmed_change) || g->near_evidence);
   const int precise = usable && g->conicity_se <= max_se && !g->outside_prior && !unconfirmed_change;
   /* the prior's interval, and the uncertain estimate's where it is the more cautious */
   double lambda = c->conicity_fallback, lambda_opt = c->conicity_prior_low;
@@ -425,6 +427,7 @@ static hm_status assess(hm_alarm a, const hm_estimate *e, const hm_margin_estima
   s->watch_from_kmh = from - hypot(h, c->watch_speed_margin_kmh);
   /* what the WARN rule risks (alarm.h): the interval read as normal, its lower half-width interval_z standard errors */
   s->warn_risk = precise && h > 0.0 ? 0.5 * erfc((from - s->warn_from_kmh) / (h / z) / sqrt(2.0)) : NAN;
+  /* (the cap makes it larger than one standard error's 0.159 where the error exceeds the cap) */
   /* the edge: at the conicity in use where the origin is stable there; inside the Hopf interval above the point
    * estimate, at the interval's optimistic end (found by the lookup at the conicity whose Hopf speed is hopf_high,
    * which the table's affine 1/V^2 makes exact) */

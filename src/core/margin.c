@@ -168,6 +168,9 @@ static hm_window_verdict prepare_reading(const hm_margin m, double t_end, double
   if (t_end - window_s < m->last_end_s - 1e-9) return HM_WINDOW_OVERLAPS;
   /* statistical and systematic errors of the measured mode (the leakage of a T s window: about 1 / T) */
   double sys_sigma = c->decay_rate_model_error * fabs(mode->decay_rate_1_s) + 1.0 / fmax(window_s, 1.0);
+  /* a second reading the likelihood could not rule out (modal.h: a broad resonance beside the mode): the difference
+   * is an error of the decay rate */
+  if (mode->decay_rate_alt_1_s < 0.0) sys_sigma = hypot(sys_sigma, mode->decay_rate_1_s - mode->decay_rate_alt_1_s);
   /* a decay rate at its bound 0 (a line's reading, or a mode narrower than the window resolves) inverted just below */
   const double sigma = fmin(mode->decay_rate_1_s, -1e-6);
   const double sys_f = c->frequency_model_error * mode->frequency_hz;
@@ -523,6 +526,9 @@ void hm_margin_read(const hm_margin m, double now, hm_margin_estimate *out) {
   /* an estimate outside the prior's range by more than interval_z of its error */
   if (r.conicity_valid && m->prior_high > 0.0)
     r.outside_prior = r.conicity_low > m->prior_high ? 1 : r.conicity_high < m->prior_low ? -1 : 0;
+  /* a window whose mode is lightly damped (|sigma| at most HM_MARGIN_NEAR_DECAY_1_S): instability is near, whatever
+   * the model says of it (margin.h) */
+  for (size_t k = 0; k < n; ++k) r.near_evidence |= fabs(ws[k]->sigma) <= HM_MARGIN_NEAR_DECAY_1_S;
   r.model_mismatch = (r.hopf_model_valid && r.hopf_free_valid &&
                       (r.hopf_model_high_kmh < r.hopf_free_low_kmh || r.hopf_free_high_kmh < r.hopf_model_low_kmh)) ||
                      r.n_misfits >= 2;

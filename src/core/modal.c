@@ -237,6 +237,7 @@ void hm_mode_estimate_use_reading(hm_mode_estimate *e, const hm_mode_reading *r)
   e->second_frequency_hz = r->second_frequency_hz;
   e->second_decay_rate_1_s = r->second_decay_rate_1_s;
   e->two_pair_lr = r->two_pair_lr;
+  e->decay_rate_alt_1_s = r->decay_rate_alt_1_s;
   e->peak_core_z = r->peak_core_z;
   e->iterations = r->iterations;
 }
@@ -257,6 +258,7 @@ void hm_mode_estimate_reading(const hm_mode_estimate *e, hm_mode_reading *r) {
   r->second_frequency_hz = e->second_frequency_hz;
   r->second_decay_rate_1_s = e->second_decay_rate_1_s;
   r->two_pair_lr = e->two_pair_lr;
+  r->decay_rate_alt_1_s = e->decay_rate_alt_1_s;
   r->peak_core_z = e->peak_core_z;
   r->iterations = e->iterations;
 }
@@ -439,11 +441,13 @@ static int fit_reading(hm_modal m, warm_start *ws, const window_geometry *g, siz
   ws->have2 = found2 && in_band(m, th2[HM_W_W0]) && in_band(m, th2[HM_W_W02]);
   if (found2) memcpy(ws->th2, th2, sizeof th2);
   const double lr = found2 ? 2.0 * (obj1 - obj2) / g->padding : 0.0;
-  const int two = found2 && lr > HM_MODAL_TWO_PAIR_LR && two_pairs_tell(m, g, th2, th1);
+  const int tells = found2 && lr > HM_MODAL_TWO_PAIR_LR_WEAK && two_pairs_tell(m, g, th2, th1);
+  const int two = tells && lr > HM_MODAL_TWO_PAIR_LR;
   *poles = two ? 2 : 1;
   memcpy(th, two ? th2 : th1, sizeof(double) * NPM);
   reading_of(m, g, &d, th, *poles, two ? (const double(*)[NPM])f2 : (const double(*)[NPM])f1, r);
   r->two_pair_lr = lr;
+  r->decay_rate_alt_1_s = tells && !two ? -fmin(fabs(th2[HM_W_SIGMA]), fabs(th2[HM_W_SIGMA2])) : 0.0;
   r->iterations = iters;
   return 1;
 }

@@ -201,23 +201,33 @@ void MonitorRos::refineTable() {
   }
 }
 
-void MonitorRos::timeJumped(const std::string& what) {
-  hm_monitor_reset(monitor_);
+void MonitorRos::timeJumped(const std::string& what, double delta_s) {
+  // a known step keeps the windows and a held ALARM, their ages moved with it; the stream restarts (monitor.h)
+  hm_monitor_time_jump(monitor_, delta_s);
   ++time_jumps_;
   last_jump_ = what;
   last_jump_at_ = ros::WallTime::now().toSec();
-  ROS_WARN("hunting_monitor: %s: monitor reset, monitoring again after its settling time", what.c_str());
+  ROS_WARN("hunting_monitor: %s: the stream restarted (windows and a held ALARM kept), monitoring again after its "
+           "settling time", what.c_str());
   updater_.force_update();  // now, and its period restarts on the new time line (it would wait for the old one)
 }
 
 void MonitorRos::checkRosTime(const ros::Time& now) {
   const double t = now.toSec();
   if (last_ros_time_ > 0.0 && t < last_ros_time_ - 0.5) {
-    char what[160];
-    std::snprintf(what, sizeof what, "ROS time moved backwards by %.3f s (a bag restarted or looped)",
-                  last_ros_time_ - t);
-    hm_clock_reset(&clock_);
-    timeJumped(what);
+    const double delta = t - last_ros_time_;
+    if (header_time_ && accel_type_ == "imu") {
+      // the monitor's time line is the sensor's stamps: ROS time alone stepped (an NTP correction) and the clock's
+      // offset moves with it; if the stamps stepped too (a bag looped), the clock sees that step (onAccelImu)
+      hm_clock_shift(&clock_, delta);
+      ROS_WARN("hunting_monitor: ROS time moved backwards by %.3f s: the sensor clock's offset follows it", -delta);
+    } else {
+      char what[160];
+      std::snprintf(what, sizeof what, "ROS time moved backwards by %.3f s (an NTP correction, a bag restarted or "
+                    "looped)", -delta);
+      hm_clock_reset(&clock_);
+      timeJumped(what, delta);
+    }
   }
   last_ros_time_ = t;
 }
@@ -250,7 +260,7 @@ void MonitorRos::onAccelImu(const sensor_msgs::Imu::ConstPtr& msg) {
     std::snprintf(what, sizeof what,
                   "sensor stamps %.3f s off their time line for %.1f s (its clock stepped): ROS time - stamp now %.3f s",
                   clock_.offset_s - before, clock_.cfg.confirm_s, clock_.offset_s);
-    timeJumped(what);
+    timeJumped(what, before - clock_.offset_s);  // the stamps moved by minus the offset's change
   }
   pushAccel(stamp, value);
 }

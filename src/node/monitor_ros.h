@@ -44,7 +44,7 @@ class MonitorRos {
   // are ROS time and the offset 0.
   void checkRosTime(const ros::Time& now);
   double lineTime(const ros::Time& now) { return hm_clock_to_sensor(&clock_, now.toSec()); }
-  void timeJumped(const std::string& what);
+  void timeJumped(const std::string& what, double delta_s);
   void onTimer(const ros::TimerEvent& ev);
   void refineTable();
   void publishMarkers(const hm_monitor_status& st, const ros::Time& now);

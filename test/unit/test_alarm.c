@@ -376,7 +376,8 @@ static void levels_with_a_conicity_estimate(void) {
   /* too uncertain to be used alone (0.16 +- 0.05): not replaced by the narrower prior (0.1358 in 0.1058..0.1658) but
    * combined with it, the more cautious of each: the estimate's point (its Hopf speed is the lower), its low end
    * (Hopf at 0.26), the prior's high end (Hopf at 0.1058); WARN from the more cautious of the prior's (its low end
-   * less 10 km/h) and the estimate's own (its point less one standard error, h / 2): at 400 km/h WATCH, WARN above */
+   * less 10 km/h) and the estimate's own (its point less one standard error, h / 2, at most 20 km/h): at 400 km/h
+   * WATCH, WARN above */
   hm_margin_estimate wide = g;
   wide.conicity_se = 0.05;
   wide.conicity_low = 0.06;
@@ -391,7 +392,8 @@ static void levels_with_a_conicity_estimate(void) {
            "uncertain estimate: conicity %g, from estimate %d", s.conicity, s.conicity_from_estimate);
   HM_CHECK_DELTA(s.hopf_low_kmh, hopf_closed_form(0.26), 1e-9, "uncertain estimate: low end");
   HM_CHECK_DELTA(s.hopf_high_kmh, hopf_closed_form(0.1358 - 0.03), 1e-9, "uncertain estimate: high end");
-  const double from_e = hopf_closed_form(0.16) - 0.5 * (hopf_closed_form(0.16) - hopf_closed_form(0.26));
+  const double from_e =
+      hopf_closed_form(0.16) - fmin(0.5 * (hopf_closed_form(0.16) - hopf_closed_form(0.26)), HM_ALARM_WARN_MAX_BELOW_KMH);
   HM_CHECK_DELTA(s.warn_from_kmh, fmin(hopf_closed_form(0.1658) - 10.0, from_e), 1e-9, "uncertain estimate: WARN from");
   HM_CHECK(s.level == HM_LEVEL_WATCH && s.reason == HM_REASON_APPROACHING_HOPF, "uncertain estimate at 400 km/h: %s",
            hm_level_name(s.level));
@@ -616,6 +618,7 @@ static void what_the_model_may_not_explain(void) {
   low.hopf_model_kmh = hopf_closed_form(0.08);
   low.hopf_model_low_kmh = hopf_closed_form(0.086), low.hopf_model_high_kmh = hopf_closed_form(0.074);
   high.conicity = 0.29, high.conicity_low = 0.284, high.conicity_high = 0.296, high.outside_prior = 1;
+  high.near_evidence = 1;
   high.hopf_model_kmh = hopf_closed_form(0.29);
   high.hopf_model_low_kmh = hopf_closed_form(0.296), high.hopf_model_high_kmh = hopf_closed_form(0.284);
   hm_alarm a = make_prior(0.0, 0.0);
@@ -640,6 +643,15 @@ static void what_the_model_may_not_explain(void) {
            "0.29: %s (%s)", hm_level_name(s.level), hm_reason_text(s.reason));
   HM_CHECK_DELTA(s.hopf_low_kmh, hopf_closed_form(0.296), 1e-9, "0.29 lowers the low end");
   HM_CHECK_DELTA(s.hopf_high_kmh, hopf_closed_form(0.284), 1e-9, "0.29 lowers the high end");
+  hm_alarm_destroy(a);
+  /* the same estimate with no window near its Hopf speed (all of them more than 50 km/h below 342.7): reported (WATCH),
+   * the prior's interval kept: at 360 km/h WATCH, not ALARM */
+  high.near_evidence = 0;
+  a = make_prior(0.0, 0.0);
+  HM_CHECK(hm_alarm_update(a, &e, &high, 0.0, &s) == HM_OK && s.level == HM_LEVEL_WATCH &&
+               s.reason == HM_REASON_OUTSIDE_PRIOR && !s.model_interval_used,
+           "0.29 without near evidence: %s (%s)", hm_level_name(s.level), hm_reason_text(s.reason));
+  HM_CHECK_DELTA(s.hopf_low_kmh, prior_lo, 1e-9, "0.29 without near evidence: the prior's low end");
   hm_alarm_destroy(a);
   /* mismatch and a frame sensor: the prior at 470 km/h (WARN), not the estimate (0.16 alone: WARN from 463.8) */
   hm_margin_estimate g = identified();
@@ -669,7 +681,7 @@ static void what_the_model_may_not_explain(void) {
   hm_alarm_destroy(a);
   /* a change's first window: with the prior, the more cautious; the second alone */
   hm_margin_estimate ch = g;
-  ch.n_changes = 1, ch.windows_since_change = 1;
+  ch.n_changes = 1, ch.windows_since_change = 1, ch.near_evidence = 1;
   a = make_prior(0.0, 0.0);
   e = estimate(400.0, 0.0);
   HM_CHECK(hm_alarm_update(a, &e, &ch, 0.0, &s) == HM_OK && !s.conicity_from_estimate && s.model_interval_used,
