@@ -26,7 +26,8 @@
  *    than about 1 / T is, over T seconds, a sinusoid) and both readings are given, the mode's and line_reading
  *    without it (narrow_peak): the margin decides with the model and what it knows (margin.h).
  *  - A reading is valid when converged, lightly damped (damping ratio below 0.5), a peak (over 3 times the band's
- *    mean), inside the band, and informative (the decay rate's standard error at most HM_MODAL_INFORMATIVE_SE_1_S +
+ *    mean, and ln(bins) more over the few bins a narrow one covers: the largest of 650 chance ordinates reaches 6.5),
+ *    inside the band, and informative (the decay rate's standard error at most HM_MODAL_INFORMATIVE_SE_1_S +
  *    HM_MODAL_INFORMATIVE_REL |sigma|).
  *  - Whittle's log-likelihood  -sum(ln S_k + I_k / S_k)  is maximised by Fisher scoring with Levenberg damping
  *    (J = d ln S / d theta, step (J'J + mu D)^-1 J'(I/S - 1)), warm-started from the previous fit (a decay rate at
@@ -138,6 +139,9 @@ typedef struct {
 
 /* A lone candidate is a line when its harmonic F statistic (lines.h) is at least this (F(2, 12) beyond it: 1.5e-4). */
 #define HM_MODAL_LINE_F 20.0
+/* ... and for one the mode sits on while as narrow as a line (F(2, 12) beyond it: 5e-3; a mode at -0.1 to -0.56 1/s
+ * reached 4-14 on its own peak, a weak line fitted as a mode of -0.23 1/s 11.7). */
+#define HM_MODAL_LINE_F_ON_MODE 8.0
 /* A reading is informative when decay_rate_se <= HM_MODAL_INFORMATIVE_SE_1_S + HM_MODAL_INFORMATIVE_REL |sigma|. */
 #define HM_MODAL_INFORMATIVE_SE_1_S 0.5
 #define HM_MODAL_INFORMATIVE_REL 0.5

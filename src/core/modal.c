@@ -322,8 +322,12 @@ static void reading_of(const hm_modal m, const window_geometry *g, const hm_whit
   r->informative = isfinite(r->decay_rate_se_1_s) &&
                    r->decay_rate_se_1_s <= HM_MODAL_INFORMATIVE_SE_1_S + HM_MODAL_INFORMATIVE_REL * fabs(sg);
   const double margin_hz = 3.0 * r->frequency_se_hz + 2.0 * g->df;
+  /* a peak: over 3 times the band's mean, and for one narrower than a few bins over what the largest of the band's
+   * ordinates reaches by chance (about ln n: the peak's bins, a_e T / pi of them, average that much less) */
+  const double cover = fmax(1.0, (-sg + HM_WHITTLE_LEAKAGE / g->T) * g->T / HM_PI);
   r->valid = r->informative && isfinite(r->frequency_se_hz) && r->frequency_hz > m->cfg.band_low_hz + margin_hz &&
-             r->frequency_hz < m->cfg.band_high_hz - margin_hz && r->damping_ratio < 0.5 && r->peak_to_mean > 3.0;
+             r->frequency_hz < m->cfg.band_high_hz - margin_hz && r->damping_ratio < 0.5 &&
+             r->peak_to_mean > 3.0 + log((double)d->n) / cover;
 }
 
 /* An angular frequency [rad/s] inside the band. */
@@ -460,17 +464,20 @@ static int narrow_on(const window_geometry *g, const hm_mode_reading *r, double 
          fabs(f_hz - r->frequency_hz) <= 1.5 / g->T + 2.0 * r->frequency_se_hz;
 }
 
-/* Which of the lone candidates in the band are sinusoids (lines.h's harmonic F test at HM_MODAL_LINE_F or more):
+/* Which of the lone candidates in the band are sinusoids (lines.h's harmonic F test at HM_MODAL_LINE_F or more, or at
+ * HM_MODAL_LINE_F_ON_MODE for one the window's mode sits on as narrow as a line: that one goes to the narrow-peak
+ * question rather than being set aside, modal.h, and a weak line fitted as a narrow mode must reach it):
  * their indices in lr into idx, their fitted lines into fits and their local backgrounds into bgs; their count. */
-static unsigned sinusoids(const hm_modal m, const window_geometry *g, const hm_lines_result *lr, size_t n,
-                          unsigned *idx, hm_lines_sinusoid *fits, double *bgs) {
+static unsigned sinusoids(const hm_modal m, const window_geometry *g, const hm_lines_result *lr,
+                          const hm_mode_reading *rd, size_t n, unsigned *idx, hm_lines_sinusoid *fits, double *bgs) {
   unsigned count = 0;
   for (unsigned j = 0; j < lr->n_lone; ++j) {
     const size_t k = lr->lone_bin[j];
     if (k < g->k0 || k > g->k1 || m->set_aside[k]) continue;
     hm_lines_sinusoid fit;
     if (hm_lines_fit_sinusoid(m->re, m->im, m->nfft / 2 + 1, k, n, m->nfft, &fit) != HM_OK) continue;
-    if (fit.f_stat >= HM_MODAL_LINE_F) idx[count] = j, bgs[count] = m->power[k] / lr->lone_ratio[j], fits[count++] = fit;
+    const double needed = narrow_on(g, rd, lr->lone_hz[j]) ? HM_MODAL_LINE_F_ON_MODE : HM_MODAL_LINE_F;
+    if (fit.f_stat >= needed) idx[count] = j, bgs[count] = m->power[k] / lr->lone_ratio[j], fits[count++] = fit;
   }
   return count;
 }
@@ -562,13 +569,15 @@ hm_status hm_modal_fit(hm_modal m, double max_window_s, double speed_spread_rel,
   }
   hm_mode_reading rd;
   memset(&rd, 0, sizeof rd);
-  if (!fit_reading(m, &m->warm[0], &g, nb, &rd, th, &poles)) return HM_ENOCONV;
+  /* (a fit that fails, or leaves the band, still lets the lines be found and set aside: the refit may succeed) */
+  const int fitted = fit_reading(m, &m->warm[0], &g, nb, &rd, th, &poles);
+  if (!fitted || !in_band(m, 2.0 * HM_PI * rd.frequency_hz)) rd.decay_rate_1_s = -INFINITY, rd.decay_rate_se_1_s = 0.0;
   /* lone lines (sinusoids among the lone candidates): set aside, but for one the mode sits on while as narrow as a
    * line, which is the narrow-peak question (modal.h) */
   unsigned lines[HM_LINES_MAX_LONE];
   hm_lines_sinusoid fits[HM_LINES_MAX_LONE];
   double bgs[HM_LINES_MAX_LONE];
-  const unsigned n_lines = sinusoids(m, &g, &lr, n, lines, fits, bgs);
+  const unsigned n_lines = sinusoids(m, &g, &lr, &rd, n, lines, fits, bgs);
   int narrow = -1;
   for (unsigned i = 0; i < n_lines; ++i)
     if (narrow < 0 && narrow_on(&g, &rd, lr.lone_hz[lines[i]])) narrow = (int)i;
@@ -580,6 +589,8 @@ hm_status hm_modal_fit(hm_modal m, double max_window_s, double speed_spread_rel,
       *out = r;
       return HM_OK;
     }
+  } else if (!fitted) {
+    return HM_ENOCONV;
   }
   size_t n_band = 0, n_out = 0;
   for (size_t k = g.k0; k <= g.k1; ++k) ++n_band, n_out += m->set_aside[k] != 0;

@@ -12,6 +12,7 @@
 
 extern "C" {
 #include "hunting_monitor/config.h"
+#include "hunting_monitor/linear.h"
 #include "hunting_monitor/threads.h"
 }
 
@@ -217,10 +218,9 @@ void MonitorRos::checkRosTime(const ros::Time& now) {
   if (last_ros_time_ > 0.0 && t < last_ros_time_ - 0.5) {
     const double delta = t - last_ros_time_;
     if (header_time_ && accel_type_ == "imu") {
-      // the monitor's time line is the sensor's stamps: ROS time alone stepped (an NTP correction) and the clock's
-      // offset moves with it; if the stamps stepped too (a bag looped), the clock sees that step (onAccelImu)
-      hm_clock_shift(&clock_, delta);
-      ROS_WARN("hunting_monitor: ROS time moved backwards by %.3f s: the sensor clock's offset follows it", -delta);
+      // the monitor's time line is the sensor's stamps: the next sample tells whether they stepped too (a bag
+      // restarted) or ROS time alone did (an NTP correction: onAccelImu)
+      ros_step_ = delta;
     } else {
       char what[160];
       std::snprintf(what, sizeof what, "ROS time moved backwards by %.3f s (an NTP correction, a bag restarted or "
@@ -252,6 +252,21 @@ void MonitorRos::onAccelImu(const sensor_msgs::Imu::ConstPtr& msg) {
     return;
   }
   const double stamp = msg->header.stamp.toSec();
+  if (ros_step_ != 0.0) {
+    const double step = ros_step_;
+    ros_step_ = 0.0;
+    if (last_stamp_ > -1e300 && stamp < last_stamp_ + step * 0.5) {  // the stamps stepped back with ROS time
+      char what[200];
+      std::snprintf(what, sizeof what, "ROS time moved backwards by %.3f s, the sensor's stamps by %.3f s (a bag "
+                    "restarted or looped)", -step, last_stamp_ - stamp);
+      hm_clock_reset(&clock_);
+      timeJumped(what, stamp - last_stamp_);
+    } else {  // ROS time alone: the clock's offset moves with it, the stamps' time line goes on
+      hm_clock_shift(&clock_, step);
+      ROS_WARN("hunting_monitor: ROS time moved backwards by %.3f s, the sensor's stamps did not (an NTP correction): "
+               "the clock offset follows it", -step);
+    }
+  }
   const double before = clock_.offset_s;
   hm_clock_verdict v = HM_CLOCK_DROP;
   if (hm_clock_observe(&clock_, stamp, now.toSec(), &v) != HM_OK || v == HM_CLOCK_DROP) return;
@@ -262,6 +277,7 @@ void MonitorRos::onAccelImu(const sensor_msgs::Imu::ConstPtr& msg) {
                   clock_.offset_s - before, clock_.cfg.confirm_s, clock_.offset_s);
     timeJumped(what, before - clock_.offset_s);  // the stamps moved by minus the offset's change
   }
+  last_stamp_ = stamp;
   pushAccel(stamp, value);
 }
 
@@ -300,6 +316,8 @@ void MonitorRos::onTimer(const ros::TimerEvent&) {
   m.reason = hm_reason_text(s.reason);
   m.level_latched = s.latched;
   m.latch_release_in_s = s.latched ? finite(s.release_in_s) : 0.0;
+  m.hopf_low_from_hunting = s.boundaries_valid && s.hopf_low_from_hunting;
+  m.hunted_at_kmh = s.boundaries_valid && std::isfinite(s.hunted_at_kmh) ? s.hunted_at_kmh : 0.0;
   m.speed_kmh = finite(e.speed_kmh);
   m.speed_valid = e.speed_valid;
   m.sample_rate_hz = finite(e.sample_rate_measured_hz);
@@ -322,6 +340,18 @@ void MonitorRos::onTimer(const ros::TimerEvent&) {
   m.track_line_spacing_hz = md.lines_found ? finite(md.line_fundamental_hz) : 0.0;
   m.track_line_strongest_hz = md.lines_found ? finite(md.line_strongest_hz) : 0.0;
   m.track_line_strongest_mps2 = md.lines_found ? finite(md.line_strongest_mps2) : 0.0;
+  m.mode_pole_pairs = static_cast<uint8_t>(md.valid ? md.poles : 0);
+  m.mode_second_frequency_hz = md.valid && md.poles == 2 ? finite(md.second_frequency_hz) : 0.0;
+  m.mode_second_decay_rate_1_s = md.valid && md.poles == 2 ? finite(md.second_decay_rate_1_s) : 0.0;
+  m.lone_lines = static_cast<uint8_t>(md.lone_lines);
+  m.lone_line_hz = md.lone_lines ? finite(md.lone_line_hz[0]) : 0.0;
+  m.lone_line_mps2 = md.lone_lines ? finite(md.lone_line_mps2[0]) : 0.0;
+  m.lone_line_wavelength_m =
+      md.lone_lines && md.lone_line_hz[0] > 0.0 ? finite(hm_mps_from_kmh(st.mode_speed_kmh) / md.lone_line_hz[0]) : 0.0;
+  m.narrow_peak = md.narrow_peak;
+  m.narrow_peak_hz = md.narrow_peak ? finite(md.narrow_peak_hz) : 0.0;
+  m.narrow_peak_verdict = static_cast<uint8_t>(g.narrow);
+  m.narrow_peak_verdict_text = hm_narrow_verdict_text(g.narrow);
   m.conicity_valid = g.conicity_valid;
   m.conicity_estimate = g.conicity_valid ? finite(g.conicity) : 0.0;
   m.conicity_se = g.conicity_valid ? finite(g.conicity_se) : 0.0;
@@ -337,11 +367,13 @@ void MonitorRos::onTimer(const ros::TimerEvent&) {
   m.windows_birge_ratio = finite(g.birge_ratio);
   m.misfit_windows = g.n_misfits;
   m.conicity_changes = static_cast<uint32_t>(g.n_changes);
+  m.windows_since_change = g.windows_since_change;
+  m.conicity_outside_prior = static_cast<int8_t>(g.outside_prior);
   if (g.n_changes > 0) m.last_conicity_change = ros::Time(rosTime(g.last_change_s));
   if (g.n_changes != last_changes_) {
     if (g.n_changes > last_changes_)
       ROS_WARN("hunting_monitor: the conicity changed (a window %.0f s ago disagreed with those held): the "
-               "identification starts again from the next window, the prior's interval meanwhile",
+               "identification continues from that window, with the prior (the more cautious) until a second agrees",
                lineTime(now) - g.last_change_s);
     last_changes_ = g.n_changes;
   }
@@ -350,11 +382,13 @@ void MonitorRos::onTimer(const ros::TimerEvent&) {
   m.conicity_used = s.boundaries_valid ? finite(s.conicity) : 0.0;
   m.conicity_from_estimate = s.boundaries_valid && s.conicity_from_estimate;
   m.conicity_from_prior = s.boundaries_valid && s.conicity_from_prior;
+  m.model_interval_used = s.boundaries_valid && s.model_interval_used;
   m.hopf_speed_kmh = s.boundaries_valid ? finite(b.hopf_speed_kmh) : 0.0;
   m.hopf_speed_kmh_low = s.boundaries_valid ? finite(s.hopf_low_kmh) : 0.0;
   m.hopf_speed_kmh_high = s.boundaries_valid ? finite(s.hopf_high_kmh) : 0.0;
   m.warn_from_kmh = s.boundaries_valid ? finite(s.warn_from_kmh) : 0.0;
   m.watch_from_kmh = s.boundaries_valid ? finite(s.watch_from_kmh) : 0.0;
+  m.warn_risk = s.boundaries_valid ? finite(s.warn_risk) : 0.0;
   m.anticipation_kmh = s.boundaries_valid ? finite(s.anticipation_kmh) : 0.0;
   m.lowest_cycle_speed_kmh = s.boundaries_valid ? finite(b.lowest_cycle_speed_kmh) : 0.0;
   m.margin_to_hopf_kmh = s.boundaries_valid ? finite(s.margin_hopf_kmh) : 0.0;

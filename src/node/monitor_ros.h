@@ -88,6 +88,8 @@ class MonitorRos {
   // the sensor's clock against ROS time, and time jumps
   hm_clock clock_{};
   double last_ros_time_ = 0.0;
+  double ros_step_ = 0.0;           // a step back of ROS time, judged at the next stamped sample (checkRosTime)
+  double last_stamp_ = -1e300;      // the last sample's stamp pushed
   unsigned long time_jumps_ = 0;
   std::string last_jump_;
   double last_jump_at_ = -1e300;

@@ -177,6 +177,164 @@ static void joints_are_not_the_mode(void) {
   }
 }
 
+
+/* A pole pair's exact discretisation (the coverage test's process): x_k = 2 r cos(w0 / fs) x_k-1 - r^2 x_k-2 + g e_k,
+ * r = exp(sigma / fs), its spectrum the continuous pole sigma + i w0 over a smooth background. */
+typedef struct {
+  double a1, a2, x1, x2, g;
+} pole_pair;
+
+static pole_pair pole_pair_make(double sigma, double f_hz, double fs, double gain) {
+  const double r = exp(sigma / fs), w = 2.0 * HM_PI * f_hz;
+  pole_pair p = {2.0 * r * cos(w / fs), -r * r, 0.0, 0.0, gain};
+  return p;
+}
+
+static double pole_pair_step(pole_pair *p) {
+  const double x = p->a1 * p->x1 + p->a2 * p->x2 + p->g * hm_test_gauss();
+  p->x2 = p->x1, p->x1 = x;
+  return x;
+}
+
+/* One window of T seconds at fs of up to two pole pairs (gains g1, g2; g 0: absent), a sinusoid (amplitude a_line at
+ * f_line) and white noise, after settling; its fit. */
+static hm_status fit_window(hm_modal m, double fs, double T, pole_pair *p1, pole_pair *p2, double a_line,
+                            double f_line, double noise, double *t, hm_mode_estimate *e) {
+  hm_modal_reset(m);
+  for (long k = 0; k < (long)(T * fs); ++k, *t += 1.0 / fs) {
+    double x = noise * hm_test_gauss() + a_line * sin(2.0 * HM_PI * f_line * *t + 0.3);
+    if (p1) x += pole_pair_step(p1);
+    if (p2) x += pole_pair_step(p2);
+    hm_modal_push(m, x);
+  }
+  return hm_modal_fit(m, T, 0.0, e);
+}
+
+/* A lone line is not the mode (issue #26 item 1): a broad mode (-12 1/s at 13 Hz, the hunting mode 80 km/h below the
+ * Hopf speed) with a sinusoid at 14 Hz on it (a slab's fundamental, 10-25 times the spectrum's local median), 10
+ * windows of 40 s: the line is set aside (or, where the fit sat on it as a narrow mode, its narrow peak's reading
+ * beside it is used, as the margin does for a line the model cannot produce there) and reported (its frequency to
+ * 0.01 Hz, its amplitude to 10%), the decay rate's mean within 3 standard errors of -12; with lines not rejected the
+ * same windows read the line (a decay rate over 3 times smaller in magnitude): the failure this guards against. */
+static void a_lone_line_is_not_the_mode(void) {
+  const double fs = 1000.0, T = 40.0, sigma = -6.0, a_line = 3.0;
+  for (int reject = 1; reject >= 0; --reject) {
+    hm_modal_config c;
+    hm_modal_config_default(&c);
+    c.reject_lines = reject;
+    hm_modal m = NULL;
+    HM_CHECK(hm_modal_create(&c, fs, &m, NULL, 0) == HM_OK, "create");
+    if (!m) return;
+    pole_pair p = pole_pair_make(sigma, 13.0, fs, 0.05);
+    double t = 0.0, sum = 0.0, sum_se = 0.0, amp = 0.0, f_err = 0.0;
+    int n = 0, lines = 0;
+    for (int k = 0; k < 20000; ++k) pole_pair_step(&p);
+    for (int win = 0; win < 10; ++win) {
+      hm_mode_estimate e;
+      if (fit_window(m, fs, T, &p, NULL, a_line, 14.0, 0.05, &t, &e) != HM_OK) continue;
+      /* a narrow peak's line is not the mode here (14 Hz far from a mode that damped: the margin's model says so,
+       * margin.h): the reading beside it is the window's */
+      if (e.narrow_peak) hm_mode_estimate_use_reading(&e, &e.line_reading);
+      if (!e.valid) continue;
+      ++n;
+      sum += e.decay_rate_1_s, sum_se += e.decay_rate_se_1_s;
+      const double hz = e.narrow_peak ? e.narrow_peak_hz : e.lone_lines ? e.lone_line_hz[0] : 0.0;
+      const double mps2 = e.narrow_peak ? e.narrow_peak_mps2 : e.lone_lines ? e.lone_line_mps2[0] : 0.0;
+      if (hz > 0.0) ++lines, amp += mps2, f_err = fmax(f_err, fabs(hz - 14.0));
+    }
+    hm_modal_destroy(m);
+    const double mean = n ? sum / n : 0.0, se = n ? sum_se / n / sqrt((double)n) : 0.0;
+    printf("  a lone line, %s: %d valid, decay rate %.2f (se of the mean %.2f, reference %.1f), line in %d, %.3f m/s^2 "
+           "(%.1f), off by %.4f Hz\n", reject ? "set aside" : "fitted", n, mean, se, sigma, lines,
+           lines ? amp / lines : 0.0, a_line, f_err);
+    if (reject) {
+      HM_CHECK(n >= 8 && lines == n, "%d valid fits, the line in %d", n, lines);
+      HM_CHECK_DELTA(mean, sigma, 3.0 * se, "decay rate beside the line");
+      HM_CHECK(lines && fabs(amp / lines - a_line) <= 0.1 * a_line && f_err <= 0.01, "the line reported");
+    } else {
+      HM_CHECK(n < 8 || mean > sigma / 3.0, "with the line fitted: decay rate %.2f in %d windows", mean, n);
+    }
+  }
+}
+
+/* A line alone (a sinusoid at 14 Hz in white noise: the issue's "identified" -0.036 +- 0.047 1/s, conicity 0.22 at
+ * 400 km/h) is a narrow peak: the window's reading sits on it as narrow as a line (decay rate within two standard
+ * errors of 0, the window's leakage aside) and the reading without it finds no mode; a near-Hopf mode (-0.1 1/s at
+ * 14.2 Hz) is read with its decay rate within 3 standard errors of -0.1 (1/T of leakage allowed), whether or not its
+ * peak passes for a line too (the margin then takes it for the mode where its conicity is supported: test_margin). */
+static void a_line_alone_and_a_narrow_mode(void) {
+  const double fs = 1000.0, T = 40.0;
+  hm_modal_config c;
+  hm_modal_config_default(&c);
+  hm_modal m = NULL;
+  HM_CHECK(hm_modal_create(&c, fs, &m, NULL, 0) == HM_OK, "create");
+  if (!m) return;
+  double t = 0.0;
+  int narrow = 0, aside = 0, taken = 0, beside = 0;
+  for (int win = 0; win < 10; ++win) {
+    hm_mode_estimate e;
+    if (fit_window(m, fs, T, NULL, NULL, 1.0, 14.0, 1.0, &t, &e) != HM_OK) continue;
+    narrow += e.narrow_peak && fabs(e.narrow_peak_hz - 14.0) < 0.01 &&
+              fabs(e.decay_rate_1_s) <= 2.0 * e.decay_rate_se_1_s + 0.5 / T;
+    aside += (e.lone_lines > 0 && fabs(e.lone_line_hz[0] - 14.0) < 0.01) ||
+             (e.lines_found && fabs(e.line_strongest_hz - 14.0) < 0.01);
+    taken += e.valid && !e.narrow_peak && fabs(e.frequency_hz - 14.0) < 0.05; /* read as a mode, silently */
+    beside += e.narrow_peak ? e.line_reading.valid : e.valid;
+  }
+  printf("  a sinusoid in noise, 10 windows: a narrow peak at zero decay in %d, set aside as a line in %d, read as a mode "
+         "unflagged in %d, a chance mode beside it in %d\n", narrow, aside, taken, beside);
+  HM_CHECK(narrow + aside >= 9 && taken == 0 && beside <= 2, "narrow %d, aside %d, taken %d, beside %d", narrow, aside,
+           taken, beside);
+  pole_pair p = pole_pair_make(-0.1, 14.2, fs, 0.01);
+  for (int k = 0; k < 200000; ++k) pole_pair_step(&p);
+  int n = 0;
+  narrow = 0;
+  double sum = 0.0, sum_se = 0.0;
+  for (int win = 0; win < 10; ++win) {
+    hm_mode_estimate e;
+    if (fit_window(m, fs, T, &p, NULL, 0.0, 14.0, 0.01, &t, &e) != HM_OK || !e.valid) continue;
+    ++n, narrow += e.narrow_peak, sum += e.decay_rate_1_s, sum_se += e.decay_rate_se_1_s;
+  }
+  hm_modal_destroy(m);
+  const double mean = n ? sum / n : 0.0, se = n ? sum_se / n / sqrt((double)n) : 1.0;
+  printf("  a mode at -0.1 1/s: %d valid, a narrow peak in %d, decay rate %.3f (se of the mean %.3f)\n", n, narrow,
+         mean, se);
+  HM_CHECK(n >= 9, "%d valid (narrow in %d: the margin takes it for the mode where supported, test_margin)", n, narrow);
+  HM_CHECK_DELTA(mean, -0.1, 3.0 * se + 1.0 / T, "near-Hopf decay rate (the window's leakage 1/T allowed)");
+}
+
+/* A broad mode beside the hunting mode (issue #26 item 2): the mode at -0.56 1/s, 14.24 Hz, and a broader pair (-8
+ * 1/s) at the same frequency with 3.5% of its peak, 12 windows of 40 s. A single pair averages them (the issue: -2.54);
+ * two pairs, chosen by likelihood, give the mode: the mean within 3 standard errors of -0.56 and at most -1.5 in
+ * every window chosen so (the single pair's reading is -2.5). */
+static void a_mode_beside_a_broad_resonance(void) {
+  const double fs = 1000.0, T = 40.0, sigma = -0.56;
+  hm_modal_config c;
+  hm_modal_config_default(&c);
+  hm_modal m = NULL;
+  HM_CHECK(hm_modal_create(&c, fs, &m, NULL, 0) == HM_OK, "create");
+  if (!m) return;
+  /* peak heights ~ g^2 / sigma^2: the broad one's 3.5% of the narrow's at g2 / g1 = sqrt(0.035) 8 / 0.56 */
+  pole_pair p1 = pole_pair_make(sigma, 14.24, fs, 1.0), p2 = pole_pair_make(-8.0, 14.24, fs, sqrt(0.035) * 8.0 / 0.56);
+  for (int k = 0; k < 100000; ++k) pole_pair_step(&p1), pole_pair_step(&p2);
+  double t = 0.0, sum = 0.0, sum_se = 0.0, worst = -INFINITY;
+  int n = 0, two = 0;
+  for (int win = 0; win < 12; ++win) {
+    hm_mode_estimate e;
+    if (fit_window(m, fs, T, &p1, &p2, 0.0, 14.0, 1.0, &t, &e) != HM_OK || !e.valid) continue;
+    ++n;
+    if (e.poles != 2) continue;
+    ++two, sum += e.decay_rate_1_s, sum_se += e.decay_rate_se_1_s, worst = fmax(worst, -e.decay_rate_1_s);
+  }
+  hm_modal_destroy(m);
+  const double mean = two ? sum / two : 0.0, se = two ? sum_se / two / sqrt((double)two) : 1.0;
+  printf("  a broad mode beside the mode: %d valid, two pairs in %d, the mode's decay rate %.3f (se of the mean %.3f, "
+         "reference %.2f), the most damped %.2f\n", n, two, mean, se, sigma, -worst);
+  HM_CHECK(n >= 10 && two >= 8, "%d valid, two pairs in %d", n, two);
+  HM_CHECK_DELTA(mean, sigma, 3.0 * se, "the mode beside a broad one");
+  HM_CHECK(worst <= 1.5, "a window read %.2f 1/s", -worst);
+}
+
 /* The coverage of the decay rate's 2-standard-error intervals (issue #18), Monte Carlo over 480 windows: a pole pair at
  * 14 Hz with decay rates -0.05, -0.2, -1, -4 and -8 1/s (damping ratios 0.0006 to 0.09: from at the Hopf speed to 100
  * km/h below it, and the 380 km/h windows of worn wheels, -7.1 1/s), windows of 20 and 40 s, input rates 2000, 1250 and
@@ -300,6 +458,9 @@ static void real_fft_is_the_dft(void) {
 }
 
 int main(void) {
+  HM_RUN(a_lone_line_is_not_the_mode);
+  HM_RUN(a_line_alone_and_a_narrow_mode);
+  HM_RUN(a_mode_beside_a_broad_resonance);
   HM_RUN(real_fft_is_the_dft);
   HM_RUN(decay_rate_of_a_known_oscillator);
   HM_RUN(rates_and_no_mode);
