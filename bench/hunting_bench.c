@@ -246,7 +246,7 @@ static void bench_monitor(double *ns_push, double *ns_monitor, double *ns_update
       hm_mode_estimate me;
       const int reps = 50;
       const double t1 = now_s();
-      for (int r = 0; r < reps; ++r) hm_modal_fit(md, 40.0, 0.0, &me);
+      for (int r = 0; r < reps; ++r) hm_modal_fit(md, 40.0, 0.0, 1.0, &me);
       *us_fit = (now_s() - t1) / reps * 1e6;
       hm_modal_destroy(md);
     }

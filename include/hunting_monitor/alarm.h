@@ -13,16 +13,21 @@
  *    table's interpolation error alone;
  *  - an estimate too uncertain to be used alone, outside the prior's range by more than its error (margin.h's
  *    outside_prior: WATCH, HM_REASON_OUTSIDE_PRIOR), or of a conicity change not yet confirmed by a second window, is
- *    not used alone: the level uses the more cautious of it and the prior (the lower point, and the lower of each
- *    end), so an estimate can lower the interval (hollow-worn wheels do reach 0.3-0.5) but never raise it above the
- *    prior's (a precise 0.08 would have put it at 657-742 km/h);
+ *    not used alone: with a lightly damped mode among the windows held (margin.h's near_evidence: instability is
+ *    near, whatever the model says) the level uses the more cautious of it and the prior (the lower point, and the
+ *    lower of each end), so an estimate can lower the interval (hollow-worn wheels do reach 0.3-0.5) but never raise
+ *    it above the prior's (a precise 0.08 would have put it at 657-742 km/h); without one, the prior's alone (far
+ *    below the Hopf speed a window's conicity leans on the model: a bogie read as 0.34 for 0.19, one window at 345
+ *    km/h as 0.18 +- 0.02 for 0.12, and the more cautious end gave WARN 120 km/h below the truth);
  *  - the model-based interval is not used at all when the vehicle does not behave like its model (model_mismatch)
  *    or the accelerometer is not on an axle box (hm_alarm_set_measurement_point): the prior, bounded by the
  *    model-free interval;
  *  - the model-free interval (margin.h), when valid, bounds the level as well: its lower end with model_mismatch, a
- *    sensor off the axle box, or from HM_ALARM_FREE_MIN_WINDOWS windows on (a regression through two has no residual
- *    to check it: from 50 s at 380 and 420 km/h its lower end lay 440-445 km/h on four runs of a vehicle whose Hopf
- *    speed is 473.8), its upper end with model_mismatch or a sensor off the axle box (the lower of each end).
+ *    sensor off the axle box, or from HM_ALARM_FREE_MIN_WINDOWS windows on with a lightly damped mode held (margin.h's
+ *    near_evidence; a regression through two has no residual to check it: from 50 s at 380 and 420 km/h its lower end
+ *    lay 440-445 km/h on four runs of a vehicle whose Hopf speed is 473.8; a zero crossing extrapolated from decay
+ *    rates of -5..-11 1/s is wide: 322 [309, ...] for 357 on a ramp from 271 to 301 km/h), its upper end with
+ *    model_mismatch or a sensor off the axle box (the lower of each end).
  * The table gives, at the conicity in use and the current speed, the lowest speed with a cycle, the unstable cycle
  * bounding the basin of the stable origin (the edge) and the stable cycle beyond it. Where the origin is unstable at
  * the conicity in use but the speed is still inside the Hopf interval, the edge is taken at the interval's
@@ -178,7 +183,8 @@ typedef struct {
 #define HM_ALARM_WARN_MAX_BELOW_KMH 20.0
 /* An estimate in use stays in use while its standard error is at most this times conicity_max_se. */
 #define HM_ALARM_SE_HYSTERESIS 1.25
-/* The model-free interval's lower end counts for the level from this many windows on (and with model_mismatch). */
+/* The model-free interval's lower end counts for the level from this many windows on with a lightly damped mode held
+ * (and with model_mismatch or a sensor off the axle box). */
 #define HM_ALARM_FREE_MIN_WINDOWS 3u
 /* WATCH for an ambiguous narrow peak (HM_REASON_NARROW_PEAK) while the latest such window ended this recently [s]. */
 #define HM_ALARM_NARROW_HOLD_S 60.0

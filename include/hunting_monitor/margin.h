@@ -42,13 +42,21 @@
  *     above the highest speed seen. A proportional bias of the decay rates does not move this zero.
  * A narrow peak (modal.h: the mode sits on a line-like peak, so a line and the mode near its Hopf speed look alike in
  * the window) is the hunting mode when the model produces it at this speed (its decay rate and frequency together)
- * and its conicity is supported: within change_z combined standard errors of the windows held or, without any, within
- * the prior's range (hm_margin_set_prior) to interval_z of its error. Else it is a line when the reading without it is
- * a mode of its own (the model cannot produce the narrow one, or a second resonance was fitted beside it, or that
- * mode is over 1 Hz away) and supported the same way, or above it (its Hopf speed below what is known: the cautious
+ * and its conicity is supported informatively (a line and that mode give the same conicity, the one whose Hopf speed
+ * is the current speed): within interval_z combined standard errors of the windows held and, unless they know the
+ * conicity better than the prior's range, inside that range (hm_margin_set_prior) to interval_z of its error; without
+ * windows, inside the range. Else it is a line when the reading without it is a mode of its own (the model cannot
+ * produce the narrow one, or a second resonance was fitted beside it, or that mode is over 1 Hz away) supported by
+ * what is known (within change_z combined standard errors of the windows held or, without any, the prior's range to
+ * interval_z of its error), or above it (its Hopf speed below what is known: the cautious
  * reading, which may lower the interval, alarm.h); else the window is not used (HM_WINDOW_AMBIGUOUS; the alarm says
  * so). A line at 14 Hz at 400 km/h reads as the mode at its Hopf speed with a conicity of 0.22 where the prior
  * says 0.11-0.17: set aside when the mode beside it is found, ambiguous otherwise.
+ * A window whose speed changed (a ramp) and whose peak moved with the speed as a track line does (modal.h's
+ * speed_tracking, d ln f / d ln V between its halves, three standard errors above the model's hunting mode's at the
+ * window's conicity and closer to a line's 1 than to it) is a line smeared by the ramp, not the mode
+ * (HM_WINDOW_TRACKS_SPEED): over a 12 km/h window a slab's line at 14 Hz sweeps 0.5 Hz and reads as a mode of -0.7
+ * 1/s; taken for the mode it gave WARN 53 km/h below the Hopf speed, and its misfits raised model_mismatch.
  * model_mismatch, the vehicle not behaving like its model: both valid with disjoint intervals, or two or more
  * misfit windows (a mode the model cannot produce at that speed, e.g. a bogie mode at 8 Hz) within memory_s.
  */
@@ -140,8 +148,10 @@ typedef enum {
   HM_WINDOW_CHANGE = 7,     /* its conicity disagrees with the windows held: they were dropped, and so was it */
   HM_WINDOW_NONLINEAR = 8,  /* a criterion was met during it: hunting or its onset is not the linear mode
                                (monitor.h) */
-  HM_WINDOW_AMBIGUOUS = 9   /* its narrow peak may be a line or the mode at its Hopf speed, and neither reading is
+  HM_WINDOW_AMBIGUOUS = 9,  /* its narrow peak may be a line or the mode at its Hopf speed, and neither reading is
                                supported (below): not used */
+  HM_WINDOW_TRACKS_SPEED = 10 /* its peak moved with the speed as a track line does, not as the model's mode (below):
+                                 not used, and not a misfit */
 } hm_window_verdict;
 
 /* A short English sentence for a verdict; never NULL. */

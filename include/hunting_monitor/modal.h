@@ -135,7 +135,17 @@ typedef struct {
   int narrow_peak;
   double narrow_peak_hz, narrow_peak_mps2;
   hm_mode_reading line_reading;
+  /* how the mode's peak moved with the speed (order tracking, with the speed's change over the window given): one
+   * pair fitted to each half of the last window_s, d ln f / d ln V = ln(f2 / f1) / ln(V2 / V1) and its standard error from
+   * the halves' frequency errors. A track line's frequency is V / L (1); the model's hunting frequency changes far
+   * less with the speed (0.2-0.3 for the default vehicle, margin.h compares). NAN when not measured (the halves'
+   * speeds within HM_MODAL_TRACK_MIN_LOG of each other, or a half's fit failed or left the peak). */
+  double speed_tracking, speed_tracking_se;
 } hm_mode_estimate;
+
+/* The window's halves' speeds must differ by at least this in ln(V2 / V1) for speed_tracking: a line then moves 1% of
+ * its frequency, 0.14 Hz at 14 Hz, 3 bins of a 20 s half. */
+#define HM_MODAL_TRACK_MIN_LOG 0.01
 
 /* A lone candidate is a line when its harmonic F statistic (lines.h) is at least this (F(2, 12) beyond it: 1.5e-4). */
 #define HM_MODAL_LINE_F 20.0
@@ -177,9 +187,13 @@ void hm_modal_push(hm_modal m, double accel_mps2);
 int hm_modal_fit_due(const hm_modal m);
 /* Fit the newest max_window_s of the window (at most window_s; the caller passes less when only the newest part was
  * at a steady speed), whose speed ranged over speed_spread_rel of its mean (0 if unknown: lines of the track, which move
- * with the speed, are left out that much wider, lines.h). HM_OK with out->valid set or cleared (mode outside the band, fewer than min_window_s of data);
- * HM_ENOCONV if the scoring did not converge (out untouched); HM_EINVAL for max_window_s <= 0. */
-hm_status hm_modal_fit(hm_modal m, double max_window_s, double speed_spread_rel, hm_mode_estimate *out);
+ * with the speed, are left out that much wider, lines.h); over the last window_s (the whole window, where the peak's
+ * movement is measured: speed_tracking) the newer half's mean speed was halves_speed_ratio times the older half's (1,
+ * or 0 if unknown: not measured). HM_OK with out->valid set or cleared (mode
+ * outside the band, fewer than min_window_s of data); HM_ENOCONV if the scoring did not converge (out untouched);
+ * HM_EINVAL for max_window_s <= 0. */
+hm_status hm_modal_fit(hm_modal m, double max_window_s, double speed_spread_rel, double halves_speed_ratio,
+                       hm_mode_estimate *out);
 
 #ifdef __cplusplus
 }

@@ -93,6 +93,8 @@ static void write_line(const hm_monitor_status *st, double t) {
   jw_number(&w, "lone_line_mps2", md->lone_lines ? md->lone_line_mps2[0] : NAN);
   jw_number(&w, "lone_line_wavelength_m",
             md->lone_lines && md->lone_line_hz[0] > 0.0 ? hm_mps_from_kmh(st->mode_speed_kmh) / md->lone_line_hz[0] : NAN);
+  jw_number(&w, "mode_speed_tracking", md->speed_tracking);
+  jw_number(&w, "mode_speed_tracking_se", md->speed_tracking_se);
   jw_bool(&w, "narrow_peak", md->narrow_peak);
   jw_number(&w, "narrow_peak_hz", md->narrow_peak ? md->narrow_peak_hz : NAN);
   jw_string(&w, "narrow_peak_taken_for", hm_narrow_verdict_text(g->narrow));

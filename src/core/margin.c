@@ -51,6 +51,7 @@ const char *hm_window_verdict_text(hm_window_verdict v) {
     case HM_WINDOW_NONLINEAR: return "a criterion was met during it: hunting is not the linear mode";
     case HM_WINDOW_AMBIGUOUS:
       return "a narrow peak: a line, or the mode at its Hopf speed at a conicity nothing else supports: not used";
+    case HM_WINDOW_TRACKS_SPEED: return "its peak moved with the speed like a track line, not like the mode: not used";
   }
   return "?";
 }
@@ -238,6 +239,24 @@ static int supported(const hm_margin m, const window *w) {
   return hi <= 0.0 || (w->lambda + z >= lo && w->lambda - z <= hi);
 }
 
+/* A narrow peak's conicity that what is known supports as the mode at its Hopf speed. A line and that mode give the
+ * same conicity (the one whose Hopf speed is the current speed), so the support must be informative: within
+ * interval_z (not change_z) combined standard errors of the windows held, and inside the prior's range as well unless
+ * the windows know the conicity better than the prior (a window of 0.29 +- 0.05 held would support 0.44: a 13.9 Hz
+ * sinusoid at 273 km/h, WARN 75 km/h below a Hopf speed of 350). */
+static int supports_narrow(const hm_margin m, const window *w) {
+  double lo, hi, se;
+  int from_windows;
+  known(m, w->t_end_s, &lo, &hi, &se, &from_windows);
+  const double z = m->cfg.interval_z;
+  const int in_prior = m->prior_high <= 0.0 || (w->lambda + z * w->lambda_se >= m->prior_low &&
+                                                w->lambda - z * w->lambda_se <= m->prior_high);
+  if (!from_windows) return in_prior;
+  const int agrees = fabs(w->lambda - lo) <= z * hypot(w->lambda_se, se);
+  const int windows_know_better = m->prior_high <= 0.0 || 2.0 * z * se <= m->prior_high - m->prior_low;
+  return agrees && (windows_know_better || in_prior);
+}
+
 /* A window's conicity above what is known (beyond change_z combined errors of the windows held, or interval_z of its
  * own above the prior's range): its Hopf speed lower, the cautious direction. */
 static int cautious(const hm_margin m, const window *w) {
@@ -248,8 +267,23 @@ static int cautious(const hm_margin m, const window *w) {
   return hi > 0.0 && w->lambda - m->cfg.interval_z * w->lambda_se > hi;
 }
 
+/* The window's peak moved with the speed as a track line does (modal.h's speed_tracking) and not as the model's
+ * hunting mode at conicity lambda: three standard errors above the model's d ln f / d ln V (from the hunting root at
+ * V -+ 2%) and at least half a line's 1 (margin.h). */
+static int tracks_speed(const hm_margin m, double speed_kmh, double lambda, const hm_mode_estimate *mode) {
+  const double k = mode->speed_tracking, se = mode->speed_tracking_se;
+  if (!isfinite(k) || !(se > 0.0) || !(lambda > 0.0)) return 0;
+  const double v1 = 0.98 * speed_kmh, v2 = 1.02 * speed_kmh;
+  double s1, w1, s2, w2;
+  if (hm_hunting_root(&m->coef, v1, lambda, &s1, &w1) != HM_OK ||
+      hm_hunting_root(&m->coef, v2, lambda, &s2, &w2) != HM_OK || !(w1 > 0.0 && w2 > 0.0))
+    return 0;
+  const double k_model = log(w2 / w1) / log(v2 / v1);
+  return k - k_model >= 3.0 * se && k >= 0.5;
+}
+
 /* A window's checks and inversion into *w. A narrow peak (modal.h) is the hunting mode near its Hopf speed when the
- * model can produce it at this speed and what is known supports its conicity; else a line when the reading without
+ * model can produce it at this speed and what is known supports its conicity (supports_narrow); else a line when the reading without
  * it is a mode of its own (the model cannot produce the narrow one, or the window held a second resonance beside it,
  * or that mode lies over 1 Hz away) that what is known supports; else it cannot be told (HM_WINDOW_AMBIGUOUS: a
  * line at the hunting frequency reads as the mode at its Hopf speed, a sinusoid at 14 Hz at 400 km/h as a conicity
@@ -260,8 +294,15 @@ static hm_window_verdict prepare(const hm_margin m, double t_end, double speed_k
   hm_mode_estimate_reading(mode, &primary);
   const hm_window_verdict v = prepare_reading(m, t_end, speed_kmh, spread_kmh, mode->window_s, &primary, w);
   *narrow = HM_NARROW_NONE;
+  if (v == HM_WINDOW_USED || v == HM_WINDOW_MISFIT || v == HM_WINDOW_NO_INVERSION) {
+    double lo, hi, se; /* the model's slope at the window's conicity, or (none found) at what is known */
+    int from_windows;
+    known(m, t_end, &lo, &hi, &se, &from_windows);
+    if (tracks_speed(m, speed_kmh, v == HM_WINDOW_USED ? w->lambda : 0.5 * (lo + hi), mode))
+      return HM_WINDOW_TRACKS_SPEED;
+  }
   if (!mode->narrow_peak) return v;
-  if (v == HM_WINDOW_USED && supported(m, w)) return *narrow = HM_NARROW_MODE, v;
+  if (v == HM_WINDOW_USED && supports_narrow(m, w)) return *narrow = HM_NARROW_MODE, v;
   window wl;
   const hm_window_verdict vl =
       prepare_reading(m, t_end, speed_kmh, spread_kmh, mode->window_s, &mode->line_reading, &wl);

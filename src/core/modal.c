@@ -507,12 +507,16 @@ static void set_line_aside(hm_modal m, const window_geometry *g, const hm_lines_
 
 /* The window's periodogram (m->power, every bin) from the newest n decimated samples, oldest first, without their
  * mean, zero-padded. */
-static void periodogram(hm_modal m, size_t n) {
-  const size_t oldest = (m->head + m->n_win - n) % m->n_win;
+static void periodogram_part(hm_modal m, size_t n, size_t start, size_t len);
+static void periodogram(hm_modal m, size_t n) { periodogram_part(m, n, 0, n); }
+
+/* The periodogram of len samples from start of the newest n (zero-padded to nfft) into m->power. */
+static void periodogram_part(hm_modal m, size_t n, size_t start, size_t len) {
+  const size_t oldest = (m->head + m->n_win - n + start) % m->n_win;
   double mean = 0.0;
-  for (size_t k = 0; k < n; ++k) mean += m->ring[(oldest + k) % m->n_win];
-  mean /= (double)n;
-  for (size_t k = 0; k < m->nfft; ++k) m->re[k] = k < n ? m->ring[(oldest + k) % m->n_win] - mean : 0.0;
+  for (size_t k = 0; k < len; ++k) mean += m->ring[(oldest + k) % m->n_win];
+  mean /= (double)len;
+  for (size_t k = 0; k < m->nfft; ++k) m->re[k] = k < len ? m->ring[(oldest + k) % m->n_win] - mean : 0.0;
   hm_fft_real(m->re, m->im, m->nfft, m->cosw, m->sinw, m->nfft_max);
   for (size_t k = 0; k <= m->nfft / 2; ++k) m->power[k] = m->re[k] * m->re[k] + m->im[k] * m->im[k];
 }
@@ -537,11 +541,70 @@ static void find_comb(hm_modal m, size_t n, double df, double T, double spread_r
   memcpy(m->set_aside, m->excluded, nbins);
 }
 
-hm_status hm_modal_fit(hm_modal m, double max_window_s, double speed_spread_rel, hm_mode_estimate *out) {
+/* The centroid [Hz] of the periodogram's excess over its local background within [f_lo, f_hi] (the bins set aside
+ * left out; the background the mean of the flanks, half as wide, either side) and its standard error (the ordinates
+ * exponential about the spectrum, their variance its square, taken as the ordinate itself; a padded bin counts 1 /
+ * padding). For a smeared line it is the mean of its instantaneous frequency; for a mode with fixed poles, its
+ * frequency (the Lorentzian is symmetric). 0 if no excess. */
+static int centroid(const hm_modal m, const window_geometry *g, double f_lo, double f_hi, double *f, double *se) {
+  const double w = f_hi - f_lo;
+  double bg = 0.0, nbg = 0.0;
+  for (size_t k = g->k0; k <= g->k1; ++k) {
+    const double fk = (double)k * g->df;
+    if (!m->set_aside[k] && ((fk >= f_lo - 0.5 * w && fk < f_lo) || (fk > f_hi && fk <= f_hi + 0.5 * w)))
+      bg += m->power[k], nbg += 1.0;
+  }
+  if (!(nbg > 0.0)) return 0;
+  bg /= nbg;
+  double s0 = 0.0, s1 = 0.0;
+  for (size_t k = g->k0; k <= g->k1; ++k) {
+    const double fk = (double)k * g->df;
+    if (m->set_aside[k] || fk < f_lo || fk > f_hi) continue;
+    s0 += m->power[k] - bg;
+    s1 += fk * (m->power[k] - bg);
+  }
+  if (!(s0 > 0.0)) return 0;
+  const double c = s1 / s0;
+  double v = 0.0;
+  for (size_t k = g->k0; k <= g->k1; ++k) {
+    const double fk = (double)k * g->df;
+    if (m->set_aside[k] || fk < f_lo || fk > f_hi) continue;
+    v += (fk - c) * (fk - c) * m->power[k] * m->power[k];
+  }
+  *f = c;
+  *se = sqrt(v * g->padding) / s0;
+  return 1;
+}
+
+/* Order tracking (modal.h's speed_tracking): the centroid of the reading's peak in each half of the newest n samples,
+ * over its width (three half-widths of the pair widened by the half's leakage) and the distance a line moves with the
+ * halves' speed ratio q; d ln f / d ln V from the two. 0 if a half shows no peak there. Overwrites m->power. */
+static int halves_tracking(hm_modal m, size_t n, const window_geometry *g, const hm_mode_reading *rd, double q,
+                           double *k, double *k_se) {
+  const size_t h = n / 2;
+  window_geometry gh = *g;
+  gh.T = (double)h / m->fd;
+  gh.padding = (double)m->nfft / (double)h;
+  const double lq = log(q), f0 = rd->frequency_hz;
+  const double half = 3.0 * (fabs(rd->decay_rate_1_s) + HM_WHITTLE_LEAKAGE / gh.T) / (2.0 * HM_PI) +
+                      fabs(lq) * f0 + 2.0 * gh.df;
+  double f[2], se[2];
+  for (int part = 0; part < 2; ++part) {
+    periodogram_part(m, n, part ? n - h : 0, h);
+    if (!centroid(m, &gh, f0 - half, f0 + half, &f[part], &se[part])) return 0;
+  }
+  *k = log(f[1] / f[0]) / lq;
+  *k_se = hypot(se[0] / f[0], se[1] / f[1]) / fabs(lq);
+  return 1;
+}
+
+hm_status hm_modal_fit(hm_modal m, double max_window_s, double speed_spread_rel, double halves_speed_ratio,
+                       hm_mode_estimate *out) {
   if (!m || !out || !(max_window_s > 0.0)) return HM_EINVAL;
   m->since_fit = 0;
   hm_mode_estimate r;
   memset(&r, 0, sizeof r);
+  r.speed_tracking = r.speed_tracking_se = NAN;
   const size_t n = (size_t)fmin((double)m->n_in, floor(max_window_s * m->fd + 1e-6));
   r.window_s = (double)n / m->fd;
   if (n < m->min_n) {
@@ -609,6 +672,13 @@ hm_status hm_modal_fit(hm_modal m, double max_window_s, double speed_spread_rel,
       memset(&r.line_reading, 0, sizeof r.line_reading);
   }
   hm_mode_estimate_use_reading(&r, &rd);
+  /* order tracking over the whole window (the peak is the same; a ramp's 24 s window alone leaves the halves' slope
+   * three times as uncertain) */
+  double k, k_se;
+  const size_t n_track = (size_t)fmin((double)m->n_in, floor(m->cfg.window_s * m->fd + 1e-6));
+  if (isfinite(halves_speed_ratio) && halves_speed_ratio > 0.0 && fabs(log(halves_speed_ratio)) >= HM_MODAL_TRACK_MIN_LOG &&
+      rd.valid && halves_tracking(m, n_track, &g, &rd, halves_speed_ratio, &k, &k_se))
+    r.speed_tracking = k, r.speed_tracking_se = k_se;
   *out = r;
   return HM_OK;
 }

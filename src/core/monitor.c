@@ -199,6 +199,20 @@ void hm_monitor_time_jump(hm_monitor m, double delta_s) {
   hm_alarm_shift_time(m->alarm, delta_s);
 }
 
+/* The mean speed of the newer half of the last window_s seconds over the older half's (the chunks'); 0 if unknown. */
+static double halves_ratio(const hm_monitor m, double window_s) {
+  double sum[2] = {0.0, 0.0}, n[2] = {0.0, 0.0}, t = 0.0;
+  for (size_t k = 0; k < m->n_chunks && t < window_s - 1e-9; ++k) {
+    const speed_chunk *c = &m->chunks[(m->chunk_head + m->n_chunks_cap - 1 - k) % m->n_chunks_cap];
+    const int half = t + 0.5 * c->duration_s < 0.5 * window_s ? 0 : 1; /* 0: the newer half */
+    sum[half] += c->sum;
+    n[half] += c->n;
+    t += c->duration_s;
+  }
+  if (!(n[0] > 0.0 && n[1] > 0.0 && sum[1] > 0.0)) return 0.0;
+  return (sum[0] / n[0]) / (sum[1] / n[1]);
+}
+
 /* A fit of the identification. At a steady speed (the newest stretch whose speed varied by at most the margin's
  * max_speed_spread_kmh) the part of the stretch not yet given to the margin is fitted, up to window_s: a full
  * window is committed to the margin, a shorter one (from min_window_s) is its provisional window, committed when the
@@ -240,7 +254,8 @@ static void fit(hm_monitor m, double t) {
   hm_mode_estimate e;
   const double spread_rel =
       is_steady && steady.n > 0.0 && steady.sum > 0.0 ? (steady.max - steady.min) / (steady.sum / steady.n) : 0.0;
-  if (hm_modal_fit(m->modal, for_margin ? fresh : mc->window_s, spread_rel, &e) != HM_OK) {
+  const double fitted_s = for_margin ? fresh : mc->window_s;
+  if (hm_modal_fit(m->modal, fitted_s, spread_rel, halves_ratio(m, mc->window_s), &e) != HM_OK) {
     m->mode.valid = 0;
     return;
   }

@@ -352,6 +352,9 @@ void MonitorRos::onTimer(const ros::TimerEvent&) {
   m.narrow_peak_hz = md.narrow_peak ? finite(md.narrow_peak_hz) : 0.0;
   m.narrow_peak_verdict = static_cast<uint8_t>(g.narrow);
   m.narrow_peak_verdict_text = hm_narrow_verdict_text(g.narrow);
+  m.speed_tracking_measured = std::isfinite(md.speed_tracking);
+  m.mode_speed_tracking = finite(md.speed_tracking);
+  m.mode_speed_tracking_se = finite(md.speed_tracking_se);
   m.conicity_valid = g.conicity_valid;
   m.conicity_estimate = g.conicity_valid ? finite(g.conicity) : 0.0;
   m.conicity_se = g.conicity_valid ? finite(g.conicity_se) : 0.0;

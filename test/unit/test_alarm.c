@@ -373,8 +373,8 @@ static void levels_with_a_conicity_estimate(void) {
     HM_CHECK_DELTA(s.boundaries.hopf_speed_kmh, g.hopf_model_kmh, 1e-6, "table Hopf vs closed form");
     hm_alarm_destroy(a);
   }
-  /* too uncertain to be used alone (0.16 +- 0.05): not replaced by the narrower prior (0.1358 in 0.1058..0.1658) but
-   * combined with it, the more cautious of each: the estimate's point (its Hopf speed is the lower), its low end
+  /* too uncertain to be used alone (0.16 +- 0.05): with a lightly damped mode held (near_evidence) not replaced by
+   * the narrower prior (0.1358 in 0.1058..0.1658) but combined with it, the more cautious of each: the estimate's point (its Hopf speed is the lower), its low end
    * (Hopf at 0.26), the prior's high end (Hopf at 0.1058); WARN from the more cautious of the prior's (its low end
    * less 10 km/h) and the estimate's own (its point less one standard error, h / 2, at most 20 km/h): at 400 km/h
    * WATCH, WARN above */
@@ -384,9 +384,18 @@ static void levels_with_a_conicity_estimate(void) {
   wide.conicity_high = 0.26;
   wide.hopf_model_low_kmh = hopf_closed_form(0.26);
   wide.hopf_model_high_kmh = hopf_closed_form(0.06);
+  /* without a lightly damped mode held (near_evidence 0) the uncertain estimate is not used: the prior's alone */
   hm_alarm a = make_prior(0.0, 0.0);
   hm_assessment s;
   hm_estimate e = estimate(400.0, 0.0);
+  HM_CHECK(hm_alarm_update(a, &e, &wide, 0.0, &s) == HM_OK && !s.conicity_from_estimate && s.conicity_from_prior &&
+               s.conicity == 0.1358,
+           "uncertain estimate, no near evidence: conicity %g (the prior's 0.1358)", s.conicity);
+  HM_CHECK_DELTA(s.hopf_low_kmh, hopf_closed_form(0.1658), 1e-9, "no near evidence: the prior's low end");
+  HM_CHECK_DELTA(s.hopf_high_kmh, hopf_closed_form(0.1358 - 0.03), 1e-9, "no near evidence: the prior's high end");
+  hm_alarm_destroy(a);
+  wide.near_evidence = 1;
+  a = make_prior(0.0, 0.0);
   HM_CHECK(hm_alarm_update(a, &e, &wide, 0.0, &s) == HM_OK && !s.conicity_from_estimate && s.conicity_from_prior &&
                s.conicity == 0.16,
            "uncertain estimate: conicity %g, from estimate %d", s.conicity, s.conicity_from_estimate);
@@ -405,7 +414,8 @@ static void levels_with_a_conicity_estimate(void) {
            "uncertain estimate at %.1f km/h: %s", from_e + 0.5, hm_level_name(s.level));
   hm_alarm_destroy(a);
   /* the model-free interval 30 km/h lower (and valid): its lower end does not count from two windows, does from
-   * three (WARN from the point less h / 2, h now down to the model-free end; from two, WATCH there) */
+   * three with a lightly damped mode held (WARN from the point less h / 2, h now down to the model-free end; from two,
+   * or three without one, WATCH there) */
   hm_margin_estimate lower = g;
   lower.hopf_free_valid = 1;
   lower.hopf_free_kmh = g.hopf_model_kmh - 30.0;
@@ -414,13 +424,15 @@ static void levels_with_a_conicity_estimate(void) {
   const double h_free = g.hopf_model_kmh - lower.hopf_free_low_kmh;
   const double v_free = g.hopf_model_kmh - fmax(10.0, h_free / 2.0) + 0.5;
   e = estimate(v_free, 0.0);
-  for (unsigned n = 2; n <= 3; ++n) {
-    lower.n_windows = n;
+  for (unsigned n = 2; n <= 4; ++n) {
+    /* n 2: two windows; 3: three with a lightly damped mode held; 4: three without one (the zero extrapolated) */
+    lower.n_windows = n == 4 ? 3 : n;
+    lower.near_evidence = n != 4;
     a = make();
     HM_CHECK(hm_alarm_update(a, &e, &lower, 0.0, &s) == HM_OK, "update");
     HM_CHECK_DELTA(s.hopf_low_kmh, n == 3 ? lower.hopf_free_low_kmh : g.hopf_model_low_kmh, 1e-9, "low end");
     HM_CHECK_DELTA(s.hopf_high_kmh, g.hopf_model_high_kmh, 1e-9, "high end (no mismatch: the model's)");
-    HM_CHECK(s.level == (n == 3 ? HM_LEVEL_WARN : HM_LEVEL_WATCH), "model-free lower, %u windows: %s", n,
+    HM_CHECK(s.level == (n == 3 ? HM_LEVEL_WARN : HM_LEVEL_WATCH), "model-free lower, case %u: %s", n,
              hm_level_name(s.level));
     hm_alarm_destroy(a);
   }
