@@ -128,6 +128,8 @@ static void write_line(const hm_monitor_status *st, double t) {
   jw_number(&w, "warn_from_kmh", b ? s->warn_from_kmh : NAN);
   jw_number(&w, "watch_from_kmh", b ? s->watch_from_kmh : NAN);
   jw_number(&w, "warn_risk", b ? s->warn_risk : NAN);
+  jw_number(&w, "hunted_at_kmh", b ? s->hunted_at_kmh : NAN);
+  jw_bool(&w, "hopf_low_from_hunting", b && s->hopf_low_from_hunting);
   jw_number(&w, "anticipation_kmh", b ? s->anticipation_kmh : NAN);
   jw_number(&w, "lowest_cycle_kmh", b ? s->boundaries.lowest_cycle_speed_kmh : NAN);
   jw_number(&w, "margin_hopf_kmh", b ? s->margin_hopf_kmh : NAN);
