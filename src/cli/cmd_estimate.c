@@ -287,6 +287,10 @@ int cmd_estimate(const cli_args *a) {
       const int s = cli_csv_next(&spd, run.spd_next);
       run.spd_have = s == 1;
       if (s < 0) rc = 1;
+      if (s == 0) {
+        fprintf(stderr, "hunting estimate: %s: no samples (only a header)\n", speed_path);
+        rc = 1;
+      }
       run.spd = &spd;
     }
   }
@@ -312,6 +316,20 @@ int cmd_estimate(const cli_args *a) {
   if (rc == 0 && isfinite(run.t_last) && run.t_written < run.t_last) { /* one line at the end of the data */
     hm_monitor_status st;
     if (hm_monitor_update(run.mon, run.t_last, &st) == HM_OK) write_line(&st, run.t_last);
+  }
+  /* a run that could use no speed or no acceleration is an error, whatever it printed (every line NO_DATA) */
+  hm_monitor_status end;
+  if (rc == 0 && run.mon && isfinite(run.t_last) && hm_monitor_update(run.mon, run.t_last, &end) == HM_OK) {
+    const hm_estimate *e = &end.estimate;
+    if (e->n_speed_updates <= e->n_speed_rejected) { /* every speed refused, or none */
+      fprintf(stderr, "hunting estimate: %s: no usable speed (%lu rejected)\n", speed_path ? speed_path : "--v",
+              e->n_speed_rejected);
+      rc = 1;
+    } else if (e->n_samples == 0) {
+      fprintf(stderr, "hunting estimate: %s: no usable acceleration sample (%lu rejected)\n", accel_path,
+              e->n_rejected_nonfinite + e->n_rejected_range + e->n_rejected_order);
+      rc = 1;
+    }
   }
   hm_monitor_destroy(run.mon);
   cli_csv_close(&acc);

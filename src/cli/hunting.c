@@ -517,6 +517,12 @@ int main(int argc, char **argv) {
   for (size_t i = 0; i < sizeof commands / sizeof commands[0]; ++i) {
     const command *c = &commands[i];
     if (strcmp(argv[1], c->name) != 0) continue;
+    /* --help (or -h) anywhere before "--" describes the command, whatever its options list */
+    for (int k = 2; k < argc && strcmp(argv[k], "--") != 0; ++k)
+      if (strcmp(argv[k], "--help") == 0 || strcmp(argv[k], "-h") == 0) {
+        cli_print_help(stdout, c->name, c->usage, c->summary, c->opts);
+        return 0;
+      }
     cli_args args;
     const int positional = c->run == cmd_fit_conicity; /* the data file */
     if (cli_parse(c->name, argc - 1, argv + 1, c->opts, positional, &args)) return 2;

@@ -160,10 +160,14 @@ def test_bad_input_gives_clear_errors():
 def test_help_is_available():
     p = run("--help")
     assert "critical" in p.stdout and "simulate" in p.stdout
-    for cmd in ["critical", "critical-conicity", "eig", "simulate", "lyapunov", "sweep", "hopf", "cycles",
-                "hopf-curve", "lpc-curve", "tables", "table-lookup", "fit-conicity", "estimate"]:
-        p = run(cmd, "--help")
-        assert p.stdout.startswith(f"usage: hunting {cmd}"), p.stdout
+    # every command the main help lists (delta-r and equivalent-conicity once failed with exit 2), by --help and -h
+    listed = p.stdout.split("commands:\n", 1)[1].split("\n\n", 1)[0].split("\n")
+    cmds = [line.split()[0] for line in listed if line.strip()]
+    assert {"critical", "estimate", "delta-r", "equivalent-conicity"} <= set(cmds), cmds
+    for cmd in cmds:
+        for flag in ("--help", "-h"):
+            p = run(cmd, flag)
+            assert p.returncode == 0 and p.stdout.startswith(f"usage: hunting {cmd}"), (cmd, flag, p.stdout, p.stderr)
     assert run(ok=False).returncode == 2
 
 
@@ -446,6 +450,12 @@ def test_estimate_bad_and_stale_input():
             (["--accel", acc, "--v", "400", "--kx", "9.7"], "not for this vehicle: table made for Kx 8.96"),
             (["--accel", acc, "--v", "400", "--table", corrupt], "line 4:"),
         ]
+        # an offline run with no usable speed is an error, not a stream of NO_DATA that exits 0
+        p = run("estimate", "--accel", acc, "--speed", write("hs.csv", "t_s,speed_kmh\n"), "--table", tbl, ok=False)
+        assert p.returncode == 1 and "no samples (only a header)" in p.stderr and p.stdout == "", p.stderr
+        p = run("estimate", "--accel", acc, "--speed", write("ns.csv", "t_s,speed_kmh\n0,nan\n1,-5\n2,nan\n"),
+                "--table", tbl, ok=False)
+        assert p.returncode == 1 and "no usable speed (3 rejected)" in p.stderr, p.stderr
         for args, message in cases:
             if "--table" not in args:
                 args = args + ["--table", tbl]
