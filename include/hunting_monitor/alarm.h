@@ -13,12 +13,14 @@
  *    table's interpolation error alone;
  *  - an estimate too uncertain to be used alone, outside the prior's range by more than its error (margin.h's
  *    outside_prior: WATCH, HM_REASON_OUTSIDE_PRIOR), or of a conicity change not yet confirmed by a second window, is
- *    not used alone: with a lightly damped mode among the windows held (margin.h's near_evidence: instability is
- *    near, whatever the model says) the level uses the more cautious of it and the prior (the lower point, and the
- *    lower of each end), so an estimate can lower the interval (hollow-worn wheels do reach 0.3-0.5) but never raise
- *    it above the prior's (a precise 0.08 would have put it at 657-742 km/h); without one, the prior's alone (far
- *    below the Hopf speed a window's conicity leans on the model: a bogie read as 0.34 for 0.19, one window at 345
- *    km/h as 0.18 +- 0.02 for 0.12, and the more cautious end gave WARN 120 km/h below the truth);
+ *    not used alone: precise (standard error within conicity_max_se) and above the prior's range (worn beyond it:
+ *    its Hopf speed lower), or with a lightly damped mode among the windows held (margin.h's near_evidence:
+ *    instability is near, whatever the model says), the level uses the more cautious of it and the prior (the lower
+ *    point, and the lower of each end), so an estimate can lower the interval (hollow-worn wheels do reach 0.3-0.5;
+ *    0.176 +- 0.005 for 0.18 against a prior of 0.106-0.166 must not give the prior's 465-594 km/h for a Hopf speed of
+ *    445) but never raise it above the prior's (a precise 0.08 would have put it at 657-742 km/h); otherwise the
+ *    prior's alone (far below the Hopf speed an uncertain window's conicity leans on the model: one window at 345 km/h
+ *    as 0.18 +- 0.02 for 0.12, and the more cautious end gave WARN 120 km/h below the truth);
  *  - the model-based interval is not used at all when the vehicle does not behave like its model (model_mismatch)
  *    or the accelerometer is not on an axle box (hm_alarm_set_measurement_point): the prior, bounded by the
  *    model-free interval;

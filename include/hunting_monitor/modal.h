@@ -21,8 +21,9 @@
  *  - Lines are not the mode (issues #18, #26). A comb of lines at multiples of V / L (rail joints, bridge spans,
  *    slabs; lines.h, searched over 2.5 Hz to 0.3 of the decimated rate, two teeth where only two fit) is reported and
  *    its bins are left out. A lone candidate line is a line when a harmonic F test says so (one sinusoid explains its
- *    main lobe, lines.h; F >= HM_MODAL_LINE_F): set aside and reported (lone_lines), unless the mode sits on it while
- *    as narrow as a line: then a line and the mode near its Hopf speed look alike in this window (a mode narrower
+ *    main lobe, lines.h; F >= HM_MODAL_LINE_F): set aside and reported (lone_lines), unless the mode sits on it (within
+ *    three of its half-widths |sigma| + 2 / T; others there are the mode's own peak, not set aside) while as narrow
+ *    as a line: then a line and the mode near its Hopf speed look alike in this window (a mode narrower
  *    than about 1 / T is, over T seconds, a sinusoid) and both readings are given, the mode's and line_reading
  *    without it (narrow_peak): the margin decides with the model and what it knows (margin.h).
  *  - A reading is valid when converged, lightly damped (damping ratio below 0.5), a peak (over 3 times the band's

@@ -148,6 +148,7 @@ hm_status hm_monitor_create_parallel(const hm_monitor_config *cfg, const hm_vehi
   share_prior(m);
   m->modal_ok = 1;
   m->verdict = HM_WINDOW_MODE_INVALID; /* no fit yet */
+  m->mode.speed_tracking = m->mode.speed_tracking_se = NAN;
   m->large_at = -INFINITY;
   m->conicity_in_use = NAN;
   m->refine_failed_at = NAN;
@@ -175,6 +176,7 @@ static void restart_input(hm_monitor m) {
   m->restarts = hm_estimator_restarts(m->est, &m->rate_hz);
   m->have_speed = 0;
   memset(&m->mode, 0, sizeof m->mode);
+  m->mode.speed_tracking = m->mode.speed_tracking_se = NAN; /* not measured */
   m->verdict = HM_WINDOW_MODE_INVALID;
   restart_stream(m);
 }
@@ -279,8 +281,10 @@ static void fit(hm_monitor m, double t) {
   }
   if (m->verdict == HM_WINDOW_CHANGE) m->committed_until = t; /* the change's window is committed (margin.h) */
   /* a narrow peak the margin took for a line: the mode shown is the one beside it */
-  if (m->mode.narrow_peak && hm_margin_last_narrow(m->margin) == HM_NARROW_LINE)
+  if (m->mode.narrow_peak && hm_margin_last_narrow(m->margin) == HM_NARROW_LINE) {
     hm_mode_estimate_use_reading(&m->mode, &m->mode.line_reading);
+    m->mode.speed_tracking = m->mode.speed_tracking_se = NAN; /* measured on the narrow peak's reading, not this one */
+  }
 }
 
 hm_status hm_monitor_push_accel(hm_monitor m, double t, double a) {
