@@ -25,7 +25,12 @@
  *    three of its half-widths |sigma| + 2 / T; others there are the mode's own peak, not set aside) while as narrow
  *    as a line: then a line and the mode near its Hopf speed look alike in this window (a mode narrower
  *    than about 1 / T is, over T seconds, a sinusoid) and both readings are given, the mode's and line_reading
- *    without it (narrow_peak): the margin decides with the model and what it knows (margin.h).
+ *    without it (narrow_peak): the margin decides with the model and what it knows (margin.h). A candidate that swept
+ *    more than a bin in the window (its frequency times the speed's relative spread above 1 / T: a track line on a
+ *    ramp is no fixed sinusoid and fails the F test) is that question under a reading as narrow as a line whatever
+ *    its F; and every other lone candidate outside the mode's peak (three half-widths, two frequency errors) is left
+ *    out of the fit when the reading is not line-narrow (a 20.8 Hz slab line sweeping 0.3 Hz beside a mode of -3.5
+ *    1/s at 14.1 Hz had read it as -1.5: test_modal).
  *  - A reading is valid when converged, lightly damped (damping ratio below 0.5), a peak (over 3 times the band's
  *    mean, and ln(bins) more over the few bins a narrow one covers: the largest of 650 chance ordinates reaches 6.5),
  *    inside the band, and informative (the decay rate's standard error at most HM_MODAL_INFORMATIVE_SE_1_S +
