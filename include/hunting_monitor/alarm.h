@@ -170,15 +170,26 @@ typedef struct {
  * at least 10 s before the wheelset passes 3 mm on a ramp of 0.5 km/h/s, issue #18): the speed thresholds are judged
  * on the speed the acceleration reaches in HM_ALARM_RAISE_LOOKAHEAD_S [s]. Not below the prior's range: its lower end
  * is already the cautious end of the wheels' wear, and anticipating on it as well warned 71 km/h below the Hopf speed
- * of new wheels on a ramp of 0.5 km/h/s (test_monitor_sim). The acceleration is the least of the slopes between the mean
- * speeds of the last HM_ALARM_ACCEL_BLOCKS + 1 blocks of HM_ALARM_ACCEL_BLOCK_S [s] (10 s), 0 unless every one is
- * positive, at most HM_ALARM_MAX_ACCEL_KMH_S (a high-speed train's, about 0.3 m/s^2): a step of the speed signal (a
- * sensor's jump, a simulator's step profile) moves one or two block means and no more, and the speed sensor's noise
- * (0.3 km/h r.m.s. over blocks of 10-50 samples) moves a slope by about 0.03 km/h/s (under 1 km/h ahead). */
+ * of new wheels on a ramp of 0.5 km/h/s (test_monitor_sim). The acceleration is the least-squares slope of the mean
+ * speeds of blocks of HM_ALARM_ACCEL_BLOCK_S [s] over the last HM_ALARM_ACCEL_SPAN_S [s] (once the blocks span
+ * HM_ALARM_ACCEL_MIN_SPAN_S), clamped to 0 and HM_ALARM_MAX_ACCEL_KMH_S (a high-speed train's, about 0.3 m/s^2): a
+ * driver's notches (5 s at 1 km/h/s, 5 s held; or 10 and 10) give their mean acceleration to 4%, where the least of
+ * the slopes between consecutive blocks over 10 s, as until issue #27, gave 0 (WARN 15-20 s later than on a smooth
+ * ramp of the same mean). A step of the speed signal (a sensor's jump) is no movement: a change between two updates of
+ * more than HM_ALARM_STEP_RATE_KMH_S (beyond any train's traction or braking) times their interval plus
+ * HM_ALARM_STEP_NOISE_KMH (ten times the speed sensor's 0.3 km/h r.m.s.) starts the blocks again, as a time step back
+ * or a silence of HM_ALARM_ACCEL_SILENCE_S [s] does. The sensor's noise moves the slope by about 0.002 km/h/s (0.04
+ * km/h ahead). A simulator's step profile (moves of 0.5-20 km/h/s) is a movement: its anticipation outlasts the move
+ * by up to the span, as a notch's must. */
 #define HM_ALARM_RAISE_LOOKAHEAD_S 20.0
 #define HM_ALARM_ACCEL_BLOCK_S 2.5
-#define HM_ALARM_ACCEL_BLOCKS 4u
+#define HM_ALARM_ACCEL_SPAN_S 30.0
+#define HM_ALARM_ACCEL_MIN_SPAN_S 20.0
+#define HM_ALARM_ACCEL_MAX_BLOCKS 16u
 #define HM_ALARM_MAX_ACCEL_KMH_S 1.0
+#define HM_ALARM_STEP_RATE_KMH_S 5.0
+#define HM_ALARM_STEP_NOISE_KMH 3.0
+#define HM_ALARM_ACCEL_SILENCE_S 10.0
 /* WARN below an identified point by one standard error, but not by more than this [km/h] (or the margin, if larger):
  * from windows far below the Hopf speed one standard error reached 28 km/h and WARN came 23 km/h below the truth;
  * WATCH keeps the whole half-width. The risk, Phi(-min(se, 20) / se), is in the status (warn_risk). */

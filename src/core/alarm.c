@@ -32,10 +32,11 @@ struct hm_alarm_s {
   int precise;            /* the estimate was used alone at the last update with data (its hysteresis) */
   double v_prev_kmh, t_prev_s, dvdt_kmh_s; /* the speed's trend: an exponential average of dv/dt over ~5 s */
   int have_trend;
-  /* a sustained acceleration (alarm.h): the mean speed of the block being filled and of the last full blocks */
-  double block_sum_kmh, block_sum_t_s, block_t0_s, block_last_s;
+  /* a sustained acceleration (alarm.h): the last speed, the mean of the block being filled and of the full blocks of
+   * the last HM_ALARM_ACCEL_SPAN_S */
+  double v_last_kmh, block_sum_kmh, block_sum_t_s, block_t0_s, block_last_s;
   unsigned block_n, n_blocks;
-  double block_v_kmh[HM_ALARM_ACCEL_BLOCKS + 1], block_t_s[HM_ALARM_ACCEL_BLOCKS + 1]; /* oldest first */
+  double block_v_kmh[HM_ALARM_ACCEL_MAX_BLOCKS], block_t_s[HM_ALARM_ACCEL_MAX_BLOCKS]; /* oldest first */
   /* the last table lookups (at the conicity in use and at the interval's optimistic end), reused while their
    * conicity and the speed are unchanged */
   struct {
@@ -318,11 +319,11 @@ static hm_status lookup(hm_alarm a, int k, double conicity, double speed_kmh, hm
   return HM_OK;
 }
 
-/* The block being filled joins the last ones (the oldest dropped beyond HM_ALARM_ACCEL_BLOCKS + 1). */
+/* The block being filled joins the full ones (the oldest dropped when the ring is full). */
 static void close_block(hm_alarm a) {
-  if (a->n_blocks == HM_ALARM_ACCEL_BLOCKS + 1) {
-    memmove(a->block_v_kmh, a->block_v_kmh + 1, HM_ALARM_ACCEL_BLOCKS * sizeof(double));
-    memmove(a->block_t_s, a->block_t_s + 1, HM_ALARM_ACCEL_BLOCKS * sizeof(double));
+  if (a->n_blocks == HM_ALARM_ACCEL_MAX_BLOCKS) {
+    memmove(a->block_v_kmh, a->block_v_kmh + 1, (HM_ALARM_ACCEL_MAX_BLOCKS - 1) * sizeof(double));
+    memmove(a->block_t_s, a->block_t_s + 1, (HM_ALARM_ACCEL_MAX_BLOCKS - 1) * sizeof(double));
     --a->n_blocks;
   }
   a->block_v_kmh[a->n_blocks] = a->block_sum_kmh / a->block_n;
@@ -331,29 +332,47 @@ static void close_block(hm_alarm a) {
   a->block_n = 0;
 }
 
-/* The speed into the block being filled; a full block (HM_ALARM_ACCEL_BLOCK_S) joins the last ones. The sustained
- * acceleration [km/h/s]: the least of the slopes between consecutive block means over the last
- * HM_ALARM_ACCEL_BLOCKS of them, 0 unless all are positive, at most HM_ALARM_MAX_ACCEL_KMH_S (alarm.h). Updates
- * further apart than a block give a block each (the one in progress is closed first); a time step back or a silence
- * as long as the blocks' whole span starts again. */
+/* The least-squares slope of the full blocks' mean speeds on their mean times [km/h/s]; 0 for fewer than two. */
+static double blocks_slope(const hm_alarm a) {
+  double st = 0.0, sv = 0.0;
+  for (unsigned k = 0; k < a->n_blocks; ++k) st += a->block_t_s[k], sv += a->block_v_kmh[k];
+  const double n = (double)a->n_blocks, tm = st / n, vm = sv / n;
+  double stt = 0.0, stv = 0.0;
+  for (unsigned k = 0; k < a->n_blocks; ++k) {
+    const double dt = a->block_t_s[k] - tm;
+    stt += dt * dt;
+    stv += dt * (a->block_v_kmh[k] - vm);
+  }
+  return a->n_blocks >= 2 && stt > 0.0 ? stv / stt : 0.0;
+}
+
+/* The sustained acceleration [km/h/s] (alarm.h): the speed goes into blocks of HM_ALARM_ACCEL_BLOCK_S (updates
+ * further apart than a block give a block each), and the least-squares slope of the mean speeds of the full blocks of
+ * the last HM_ALARM_ACCEL_SPAN_S, once they span HM_ALARM_ACCEL_MIN_SPAN_S, is the acceleration, clamped to [0,
+ * HM_ALARM_MAX_ACCEL_KMH_S]. A step of the signal (a change between updates beyond HM_ALARM_STEP_RATE_KMH_S times their
+ * interval plus HM_ALARM_STEP_NOISE_KMH), a time step back or a silence of HM_ALARM_ACCEL_SILENCE_S starts again (a
+ * step taken out by its own increment would leave two samples' noise as a level shift: 1.3 km/h of anticipation). */
 static double sustained_acceleration(hm_alarm a, double now, double v_kmh) {
-  const double block_s = HM_ALARM_ACCEL_BLOCK_S;
   if (a->block_n + a->n_blocks > 0 &&
-      (now < a->block_last_s || now - a->block_last_s > HM_ALARM_ACCEL_BLOCKS * block_s))
+      (now < a->block_last_s || now - a->block_last_s > HM_ALARM_ACCEL_SILENCE_S ||
+       fabs(v_kmh - a->v_last_kmh) > HM_ALARM_STEP_RATE_KMH_S * (now - a->block_last_s) + HM_ALARM_STEP_NOISE_KMH))
     a->block_n = a->n_blocks = 0;
-  if (a->block_n > 0 && now - a->block_t0_s >= block_s) close_block(a);
+  a->v_last_kmh = v_kmh;
+  if (a->block_n > 0 && now - a->block_t0_s >= HM_ALARM_ACCEL_BLOCK_S) close_block(a);
   a->block_last_s = now;
   if (a->block_n == 0) a->block_t0_s = now, a->block_sum_kmh = a->block_sum_t_s = 0.0;
   a->block_sum_kmh += v_kmh;
   a->block_sum_t_s += now - a->block_t0_s;
   ++a->block_n;
-  if (a->n_blocks < HM_ALARM_ACCEL_BLOCKS + 1) return 0.0;
-  double least = HM_ALARM_MAX_ACCEL_KMH_S;
-  for (unsigned k = 0; k < HM_ALARM_ACCEL_BLOCKS; ++k) {
-    const double dt = a->block_t_s[k + 1] - a->block_t_s[k];
-    least = fmin(least, dt > 0.0 ? (a->block_v_kmh[k + 1] - a->block_v_kmh[k]) / dt : 0.0);
+  unsigned old = 0; /* full blocks older than the span */
+  while (old < a->n_blocks && a->block_t_s[old] < now - HM_ALARM_ACCEL_SPAN_S) ++old;
+  if (old > 0) {
+    memmove(a->block_v_kmh, a->block_v_kmh + old, (a->n_blocks - old) * sizeof(double));
+    memmove(a->block_t_s, a->block_t_s + old, (a->n_blocks - old) * sizeof(double));
+    a->n_blocks -= old;
   }
-  return fmax(least, 0.0);
+  if (a->n_blocks < 2 || a->block_t_s[a->n_blocks - 1] - a->block_t_s[0] < HM_ALARM_ACCEL_MIN_SPAN_S) return 0.0;
+  return fmin(fmax(blocks_slope(a), 0.0), HM_ALARM_MAX_ACCEL_KMH_S);
 }
 
 /* WARN from an identified Hopf speed (alarm.h): the point less the larger of the margin and one standard error, the
