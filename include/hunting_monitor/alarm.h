@@ -243,7 +243,36 @@ typedef struct {
   int latched;                      /* an oscillation ALARM held until the oscillation stays calm and the speed drops */
   double release_in_s;              /* calm still needed [s] (release_s while the oscillation or the speed is not
                                        calm yet); 0 when not latched */
+  /* The hold in numbers (issue #27 item 7), while latched (else the causes HM_REASON_STARTUP, the times and speeds
+   * NAN, the seconds 0): */
+  int held;                         /* the level is ALARM only because the latch holds it (no oscillation criterion
+                                       met now, or no current data): reason is then hold_cause */
+  hm_reason hold_cause;             /* what latched the ALARM (the first oscillation reason of the episode) */
+  double hold_since_s;              /* when it latched [s] (NAN after a restarted time line) */
+  double hold_last_met_s;           /* the latest time the oscillation met a criterion, or was beyond the edge [s] */
+  double hold_release_below_kmh;    /* the calm counts only below this speed: hopf_low_kmh less hysteresis_kmh (NAN
+                                       without current boundaries) */
+  double hold_release_amplitude_m;  /* ... with the displacement amplitude below this and no criterion met */
+  double calm_s, calm_needed_s;     /* calm so far and calm needed for the release (release_s) [s] */
+  unsigned hold_waits;              /* what the release waits for: HM_HOLD_WAITS_* bits */
+  double hunted_at_s;               /* when the oscillation met a criterion at hunted_at_kmh (NAN: none) */
+  double time_s;                    /* the update's time [s] */
+  double speed_kmh;                 /* the speed judged (the estimate's; 0 without a current one) */
 } hm_assessment;
+
+/* What a held ALARM's release waits for (hm_assessment.hold_waits). */
+#define HM_HOLD_WAITS_SPEED 1u       /* the speed at or above hold_release_below_kmh */
+#define HM_HOLD_WAITS_OSCILLATION 2u /* a criterion met, or the amplitude at or above hold_release_amplitude_m */
+#define HM_HOLD_WAITS_DATA 4u        /* no current acceleration or speed: the calm is seen only with data */
+#define HM_HOLD_WAITS_TIME 8u        /* calm, counting to calm_needed_s */
+
+/* The status's reason in words, one line (for the CLI's JSON, the node's messages, diagnostics and rviz's lamp): the
+ * reason's sentence (hm_reason_text); while the level is held, that it is held, its cause and when, and the release
+ * condition in numbers, e.g. "held (sliding r.m.s. criterion exceeded at 2.0 s, last met at 298.0 s): hunting seen
+ * down to 231.9 km/h at 298.0 s; releases below 228.9 km/h after 10 s calm (calm 0.0 s: waits for the speed, 230.0
+ * km/h)". Times from t_origin_s ("at 298.0 s"), or with t_origin_s NAN as ages before the update ("12.0 s ago").
+ * Writes at most len bytes, terminated when len > 0; returns the whole text's length (as snprintf). */
+size_t hm_assessment_reason_text(const hm_assessment *s, double t_origin_s, char *buf, size_t len);
 
 typedef struct hm_alarm_s *hm_alarm;
 

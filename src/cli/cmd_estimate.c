@@ -51,10 +51,23 @@ static void write_line(const hm_monitor_status *st, double t) {
   jw_number(&w, "t_s", t);
   jw_string(&w, "level", hm_level_name(s->level));
   jw_int(&w, "reason_code", (long)s->reason);
-  jw_string(&w, "reason", hm_reason_text(s->reason));
+  char reason[512];
+  hm_assessment_reason_text(s, 0.0, reason, sizeof reason); /* with a hold's cause, times and release condition */
+  jw_string(&w, "reason", reason);
   jw_bool(&w, "level_changed", s->changed);
   jw_bool(&w, "latched", s->latched);
   jw_number(&w, "release_in_s", s->latched ? s->release_in_s : 0.0);
+  /* the hold in numbers (alarm.h) */
+  jw_bool(&w, "held", s->held);
+  jw_int(&w, "hold_cause_code", (long)s->hold_cause);
+  jw_string(&w, "hold_cause", s->latched ? hm_reason_text(s->hold_cause) : "");
+  jw_number(&w, "hold_since_s", s->hold_since_s);
+  jw_number(&w, "hold_last_met_s", s->hold_last_met_s);
+  jw_number(&w, "hold_release_below_kmh", s->hold_release_below_kmh);
+  jw_number(&w, "hold_release_amplitude_m", s->hold_release_amplitude_m);
+  jw_number(&w, "calm_s", s->calm_s);
+  jw_number(&w, "calm_needed_s", s->calm_needed_s);
+  jw_int(&w, "hold_waits", (long)s->hold_waits);
   jw_bool(&w, "speed_valid", e->speed_valid);
   jw_number(&w, "speed_kmh", e->speed_kmh);
   jw_bool(&w, "accel_valid", e->accel_valid);
@@ -129,6 +142,7 @@ static void write_line(const hm_monitor_status *st, double t) {
   jw_number(&w, "watch_from_kmh", b ? s->watch_from_kmh : NAN);
   jw_number(&w, "warn_risk", b ? s->warn_risk : NAN);
   jw_number(&w, "hunted_at_kmh", b ? s->hunted_at_kmh : NAN);
+  jw_number(&w, "hunted_at_s", b ? s->hunted_at_s : NAN);
   jw_bool(&w, "hopf_low_from_hunting", b && s->hopf_low_from_hunting);
   jw_number(&w, "anticipation_kmh", b ? s->anticipation_kmh : NAN);
   jw_number(&w, "lowest_cycle_kmh", b ? s->boundaries.lowest_cycle_speed_kmh : NAN);

@@ -2,6 +2,7 @@
 #include "hunting_monitor/alarm.h"
 
 #include <math.h>
+#include <stdarg.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -19,7 +20,9 @@ struct hm_alarm_s {
   int lower_pending;      /* the conditions for a lower level hold since lower_since */
   double lower_since;
   int latched;            /* an oscillation ALARM held (alarm.h) */
-  hm_reason latch_reason;
+  hm_reason latch_cause;  /* what latched it, when, and the latest time the oscillation met a criterion (or was beyond
+                             the edge) since; NAN: on a time line that restarted */
+  double latch_since_s, latch_last_met_s;
   int calm;               /* the release conditions hold since calm_since */
   double calm_since;
   double displacement_limit_m; /* the displacement criterion's limit (0: off) */
@@ -74,6 +77,62 @@ const char *hm_reason_text(hm_reason r) {
     case HM_REASON_NARROW_PEAK: return "a narrow peak at the hunting frequency: a line, or the mode at its Hopf speed";
   }
   return "?";
+}
+
+/* Appends to buf at *n (as snprintf: *n grows by the whole length, buf gets what fits). */
+static void append(char *buf, size_t len, size_t *n, const char *fmt, ...) {
+  va_list ap;
+  va_start(ap, fmt);
+  const int k = vsnprintf(*n < len ? buf + *n : NULL, *n < len ? len - *n : 0, fmt, ap);
+  va_end(ap);
+  if (k > 0) *n += (size_t)k;
+}
+
+/* " at T s" from the origin, or " A s ago" with the origin NAN; nothing for an unknown time. */
+static void append_when(char *buf, size_t len, size_t *n, double t_s, double now_s, double origin_s) {
+  if (!isfinite(t_s)) return;
+  if (isnan(origin_s)) append(buf, len, n, " %.1f s ago", now_s - t_s);
+  else append(buf, len, n, " at %.1f s", t_s - origin_s);
+}
+
+size_t hm_assessment_reason_text(const hm_assessment *s, double origin_s, char *buf, size_t len) {
+  size_t n = 0;
+  if (buf && len) buf[0] = '\0';
+  if (!buf) len = 0;
+  if (!s) return 0;
+  if (!s->latched || !s->held) {
+    append(buf, len, &n, "%s", hm_reason_text(s->reason));
+    return n;
+  }
+  append(buf, len, &n, "held (%s", hm_reason_text(s->hold_cause));
+  append_when(buf, len, &n, s->hold_since_s, s->time_s, origin_s);
+  if (isfinite(s->hold_last_met_s) && s->hold_last_met_s != s->hold_since_s) {
+    append(buf, len, &n, ", last met");
+    append_when(buf, len, &n, s->hold_last_met_s, s->time_s, origin_s);
+  }
+  append(buf, len, &n, "):");
+  if (isfinite(s->hunted_at_kmh)) {
+    append(buf, len, &n, " hunting seen down to %.1f km/h", s->hunted_at_kmh);
+    append_when(buf, len, &n, s->hunted_at_s, s->time_s, origin_s);
+    append(buf, len, &n, ";");
+  }
+  if (isfinite(s->hold_release_below_kmh))
+    append(buf, len, &n, " releases below %.1f km/h after %.0f s calm", s->hold_release_below_kmh, s->calm_needed_s);
+  else
+    append(buf, len, &n, " releases below the Hopf interval after %.0f s calm", s->calm_needed_s);
+  if (s->hold_waits & HM_HOLD_WAITS_DATA) {
+    append(buf, len, &n, " (no current data: the calm is seen only with data)");
+    return n;
+  }
+  append(buf, len, &n, " (calm %.1f s", s->calm_s);
+  if (s->hold_waits & (HM_HOLD_WAITS_SPEED | HM_HOLD_WAITS_OSCILLATION)) append(buf, len, &n, ": waits for");
+  if (s->hold_waits & HM_HOLD_WAITS_SPEED) append(buf, len, &n, " the speed, %.1f km/h", s->speed_kmh);
+  if ((s->hold_waits & HM_HOLD_WAITS_SPEED) && (s->hold_waits & HM_HOLD_WAITS_OSCILLATION)) append(buf, len, &n, ",");
+  if (s->hold_waits & HM_HOLD_WAITS_OSCILLATION)
+    append(buf, len, &n, " the oscillation, %.2f mm (calm below %.2f mm)", 1e3 * s->amplitude_m,
+           1e3 * s->hold_release_amplitude_m);
+  append(buf, len, &n, ")");
+  return n;
 }
 
 void hm_alarm_config_default(hm_alarm_config *c) {
@@ -195,6 +254,7 @@ void hm_alarm_restart(hm_alarm a) {
   a->lower_pending = 0;
   a->calm = 0;
   a->hunted_t_s = NAN; /* its age counts again from the next update */
+  a->latch_since_s = a->latch_last_met_s = NAN;
   a->precise = 0;
   a->have_trend = 0;
   a->dvdt_kmh_s = 0.0;
@@ -209,6 +269,8 @@ void hm_alarm_shift_time(hm_alarm a, double delta_s) {
   a->calm_since += delta_s;
   a->t_prev_s += delta_s;
   a->hunted_t_s += delta_s;
+  a->latch_since_s += delta_s;
+  a->latch_last_met_s += delta_s;
   a->block_t0_s += delta_s;
   a->block_last_s += delta_s;
   for (unsigned k = 0; k < a->n_blocks; ++k) a->block_t_s[k] += delta_s;
@@ -238,14 +300,19 @@ static int oscillation_reason(hm_reason r) {
          r == HM_REASON_AMPLITUDE_BEYOND_EDGE;
 }
 
-/* The latch's release conditions: no criterion, the oscillation small, the speed below the Hopf interval by the
- * hysteresis (the ALARM level's thresholds are relaxed by it, as everywhere). */
-static int calm_now(const hm_alarm a, const hm_estimate *e, const hm_assessment *s) {
-  const double f = a->cfg.release_amplitude_fraction;
+/* The latch's release conditions (alarm.h) in s: the speed below the Hopf interval by the hysteresis (the ALARM
+ * level's thresholds are relaxed by it, as everywhere), the displacement amplitude below release_amplitude_fraction of
+ * the displacement limit (or of the edge) and no criterion met; what is not met yet goes to s->hold_waits. */
+static void release_conditions(const hm_alarm a, const hm_estimate *e, hm_assessment *s) {
   const double limit = a->displacement_limit_m > 0.0 ? a->displacement_limit_m : s->edge_used_m;
-  const int small = s->amplitude_m < f * (limit > 0.0 ? limit : HM_ESTIMATOR_WHEELSET_DISPLACEMENT_M);
-  return !e->rms_exceeded && !e->peaks_exceeded && !e->displacement_exceeded && small &&
-         e->speed_kmh < s->hopf_low_kmh - a->cfg.hysteresis_kmh;
+  s->hold_release_below_kmh = s->hopf_low_kmh - a->cfg.hysteresis_kmh;
+  s->hold_release_amplitude_m =
+      a->cfg.release_amplitude_fraction * (limit > 0.0 ? limit : HM_ESTIMATOR_WHEELSET_DISPLACEMENT_M);
+  s->hold_waits = 0;
+  if (e->rms_exceeded || e->peaks_exceeded || e->displacement_exceeded ||
+      !(s->amplitude_m < s->hold_release_amplitude_m))
+    s->hold_waits |= HM_HOLD_WAITS_OSCILLATION;
+  if (!(e->speed_kmh < s->hold_release_below_kmh)) s->hold_waits |= HM_HOLD_WAITS_SPEED;
 }
 
 hm_status hm_alarm_set_config(hm_alarm a, const hm_alarm_config *cfg, const hm_vehicle *veh, char *why,
@@ -481,11 +548,17 @@ static void hunted_bound(hm_alarm a, const hm_estimate *e, double now, hm_assess
   if (isnan(a->hunted_t_s) && a->hunted_at_kmh < INFINITY) a->hunted_t_s = now; /* a restarted time line */
   if (!a->latched && !(now - a->hunted_t_s <= a->memory_s)) a->hunted_at_kmh = INFINITY;
   s->hunted_at_kmh = a->hunted_at_kmh < INFINITY ? a->hunted_at_kmh : NAN;
+  s->hunted_at_s = a->hunted_at_kmh < INFINITY ? a->hunted_t_s : NAN;
+  if (!(a->hunted_at_kmh < INFINITY)) return;
+  /* the thresholds below it by their margins also where it lies inside the interval (above its lower end but below
+   * the WARN speed of an identified point: the published fields agree, alarm.h) */
+  const double warn_from = a->hunted_at_kmh - a->cfg.warn_speed_margin_kmh;
+  if (warn_from < s->warn_from_kmh) s->warn_from_kmh = warn_from, s->warn_risk = NAN;
+  s->watch_from_kmh = fmin(s->watch_from_kmh, a->hunted_at_kmh - a->cfg.watch_speed_margin_kmh);
   if (!(a->hunted_at_kmh < s->hopf_low_kmh)) return;
   s->hopf_low_kmh = a->hunted_at_kmh;
   s->hopf_low_from_hunting = 1;
-  s->warn_from_kmh = fmin(s->warn_from_kmh, a->hunted_at_kmh - a->cfg.warn_speed_margin_kmh);
-  s->watch_from_kmh = fmin(s->watch_from_kmh, a->hunted_at_kmh - a->cfg.watch_speed_margin_kmh);
+  s->warn_risk = NAN; /* the interval read as normal is not what the level uses */
 }
 
 hm_status hm_alarm_update(hm_alarm a, const hm_estimate *e, const hm_margin_estimate *g, double now, hm_assessment *out) {
@@ -493,6 +566,9 @@ hm_status hm_alarm_update(hm_alarm a, const hm_estimate *e, const hm_margin_esti
   const hm_alarm_config *c = &a->cfg;
   hm_assessment s;
   memset(&s, 0, sizeof s);
+  s.time_s = now;
+  s.speed_kmh = e->speed_valid ? e->speed_kmh : 0.0;
+  s.hunted_at_kmh = s.hunted_at_s = NAN;
   hm_reason reason;
   hm_level target;
   if (!e->accel_valid || !e->speed_valid) {
@@ -503,10 +579,11 @@ hm_status hm_alarm_update(hm_alarm a, const hm_estimate *e, const hm_margin_esti
     a->block_n = a->n_blocks = 0; /* no speed: the acceleration starts again */
     if (a->latched) { /* a held ALARM outlives its data: nothing says the oscillation has gone (alarm.h) */
       target = HM_LEVEL_ALARM;
-      reason = a->latch_reason;
+      reason = a->latch_cause;
       a->calm = 0;
-      s.latched = 1;
-      s.release_in_s = c->release_s;
+      s.latched = s.held = 1;
+      s.hold_release_below_kmh = s.hold_release_amplitude_m = NAN; /* no current boundaries */
+      s.hold_waits = HM_HOLD_WAITS_DATA;
     }
   } else {
     const hm_status st = assess(a, e, g, &s);
@@ -538,24 +615,38 @@ hm_status hm_alarm_update(hm_alarm a, const hm_estimate *e, const hm_margin_esti
       hm_reason r_ahead;
       if (raw_level(a, &ahead, g, &s, a->level, &r_ahead) >= a->level) target = a->level, reason = a->reason;
     }
+    if (a->latched || (target == HM_LEVEL_ALARM && oscillation_reason(reason))) release_conditions(a, e, &s);
     if (target == HM_LEVEL_ALARM && oscillation_reason(reason)) {
+      if (!a->latched) a->latch_cause = reason, a->latch_since_s = now;
       a->latched = 1;
-      a->latch_reason = reason;
+      a->latch_last_met_s = now;
       a->calm = 0;
     } else if (a->latched) {
       /* held until calm for release_s */
-      const int calm = calm_now(a, e, &s);
-      if (!calm) a->calm = 0;
+      if (s.hold_waits) a->calm = 0;
       else if (!a->calm) a->calm = 1, a->calm_since = now;
       if (a->calm && now - a->calm_since >= c->release_s) {
         a->latched = 0; /* the hunted-at speed stays a bound for memory_s */
       } else {
         target = HM_LEVEL_ALARM;
-        reason = a->latch_reason;
-        s.release_in_s = a->calm ? c->release_s - (now - a->calm_since) : c->release_s;
+        reason = a->latch_cause;
+        s.held = 1;
+        if (a->calm) s.hold_waits = HM_HOLD_WAITS_TIME;
       }
     }
     s.latched = a->latched;
+  }
+  if (a->latched) { /* the hold in numbers (alarm.h) */
+    s.hold_cause = a->latch_cause;
+    s.hold_since_s = a->latch_since_s;
+    s.hold_last_met_s = a->latch_last_met_s;
+    s.calm_needed_s = c->release_s;
+    s.calm_s = s.held && a->calm ? now - a->calm_since : 0.0;
+    s.release_in_s = s.calm_needed_s - s.calm_s;
+  } else {
+    s.hold_cause = HM_REASON_STARTUP;
+    s.hold_since_s = s.hold_last_met_s = s.hold_release_below_kmh = s.hold_release_amplitude_m = NAN;
+    s.hold_waits = 0;
   }
   /* (with no data the latch is kept: nothing says the oscillation has gone) */
   s.changed = 0;
