@@ -201,6 +201,14 @@ typedef struct {
 #define HM_ALARM_FREE_MIN_WINDOWS 3u
 /* WATCH for an ambiguous narrow peak (HM_REASON_NARROW_PEAK) while the latest such window ended this recently [s]. */
 #define HM_ALARM_NARROW_HOLD_S 60.0
+/* The margin counts the current steady stretch as a provisional window, replaced at every fit (margin.h, monitor.h),
+ * so its flags may flip from one fit to the next. The level holds them (issue #27 item 7): model_mismatch and the
+ * model-free interval's lower end beside the model's (three windows with a lightly damped mode held; its last valid
+ * interval is kept meanwhile) are raised at once and cleared only after their condition has been false for this long
+ * [s]; the estimate's use alone (conicity_from_estimate), the less cautious reading, is dropped at once and, once
+ * dropped, taken again only after its condition has held this long (the first time at once). A stretch gives a new
+ * provisional window only after min_window_s (20 s): this is one. */
+#define HM_ALARM_FLAG_CLEAR_S 20.0
 
 /* Defaults: 0.5, 10 km/h, 30 km/h, 3 km/h, 0.1, 3 s, estimate used up to a standard error of 0.01, fallback 0
  * (the vehicle's), prior 0 / 0 (the fallback -+ 0.03), release after 10 s below half the displacement limit. */
@@ -223,6 +231,8 @@ typedef struct {
   double anticipation_kmh;          /* added to the speed for those thresholds below an identified interval: the
                                        sustained acceleration times HM_ALARM_RAISE_LOOKAHEAD_S (0 when not accelerating
                                        or on the prior) */
+  int model_mismatch;               /* the margin's model_mismatch as the level uses it (held: below) */
+  int hopf_free_used;             /* the model-free interval's lower end entered the level (held: below) */
   int model_interval_used;          /* the model-based interval entered the level: an estimate (alone or with the prior),
                                        from an axle-box sensor (measurement point wheelset), the vehicle behaving like
                                        its model (no model_mismatch) */

@@ -123,7 +123,9 @@ static void write_line(const hm_monitor_status *st, double t) {
   jw_number(&w, "hopf_free_kmh", g->hopf_free_valid ? g->hopf_free_kmh : NAN);
   jw_number(&w, "hopf_free_kmh_low", g->hopf_free_valid ? g->hopf_free_low_kmh : NAN);
   jw_number(&w, "hopf_free_kmh_high", g->hopf_free_valid ? g->hopf_free_high_kmh : NAN);
-  jw_bool(&w, "model_mismatch", g->model_mismatch);
+  /* as the level uses it (held against the provisional window's chatter, alarm.h), and as the windows say now */
+  jw_bool(&w, "model_mismatch", s->boundaries_valid ? s->model_mismatch : g->model_mismatch);
+  jw_bool(&w, "model_mismatch_windows", g->model_mismatch);
   jw_number(&w, "birge_ratio", g->birge_ratio);
   jw_int(&w, "misfit_windows", (long)g->n_misfits);
   jw_int(&w, "conicity_changes", (long)g->n_changes);
@@ -135,6 +137,7 @@ static void write_line(const hm_monitor_status *st, double t) {
   jw_bool(&w, "conicity_from_estimate", b && s->conicity_from_estimate);
   jw_bool(&w, "conicity_from_prior", b && s->conicity_from_prior);
   jw_bool(&w, "model_interval_used", b && s->model_interval_used);
+  jw_bool(&w, "hopf_free_used", b && s->hopf_free_used);
   jw_number(&w, "hopf_kmh", b ? s->boundaries.hopf_speed_kmh : NAN);
   jw_number(&w, "hopf_kmh_low", b ? s->hopf_low_kmh : NAN);
   jw_number(&w, "hopf_kmh_high", b ? s->hopf_high_kmh : NAN);

@@ -9,6 +9,12 @@
 
 #include "hunting_monitor/linear.h"
 
+/* A flag raised at once and cleared only after its condition has been false for HM_ALARM_FLAG_CLEAR_S (alarm.h). */
+typedef struct {
+  int on;
+  double false_since_s; /* NAN: the condition held at the last update */
+} sticky_flag;
+
 struct hm_alarm_s {
   hm_alarm_config cfg;            /* fallback and prior resolved for the vehicle */
   hm_vehicle veh;
@@ -33,6 +39,10 @@ struct hm_alarm_s {
                              its age counts from the next update */
   double memory_s;        /* how long a hunted-at speed bounds the interval (hm_alarm_set_memory) */
   int precise;            /* the estimate was used alone at the last update with data (its hysteresis) */
+  int precise_lost;       /* it stopped being used alone: used again once it could have been since precise_since */
+  double precise_since;   /* (NAN: it could not be at the last update) */
+  sticky_flag mismatch, free_beside; /* model_mismatch, the model-free interval beside the model's (alarm.h) */
+  double free_low_kmh, free_high_kmh; /* the last valid model-free interval */
   double v_prev_kmh, t_prev_s, dvdt_kmh_s; /* the speed's trend: an exponential average of dv/dt over ~5 s */
   int have_trend;
   /* a sustained acceleration (alarm.h): the last speed, the mean of the block being filled and of the full blocks of
@@ -228,6 +238,7 @@ hm_status hm_alarm_create(const hm_alarm_config *cfg, const hm_vehicle *veh, con
     return st;
   }
   a->table = table;
+  a->precise_since = NAN;
   a->hunted_at_kmh = INFINITY;
   a->memory_s = 900.0;
   a->level = HM_LEVEL_NO_DATA;
@@ -255,7 +266,9 @@ void hm_alarm_restart(hm_alarm a) {
   a->calm = 0;
   a->hunted_t_s = NAN; /* its age counts again from the next update */
   a->latch_since_s = a->latch_last_met_s = NAN;
-  a->precise = 0;
+  a->precise = a->precise_lost = 0;
+  a->precise_since = NAN;
+  a->mismatch.on = a->free_beside.on = 0;
   a->have_trend = 0;
   a->dvdt_kmh_s = 0.0;
   a->block_n = a->n_blocks = 0;
@@ -268,6 +281,9 @@ void hm_alarm_shift_time(hm_alarm a, double delta_s) {
   a->lower_since += delta_s;
   a->calm_since += delta_s;
   a->t_prev_s += delta_s;
+  a->precise_since += delta_s;
+  a->mismatch.false_since_s += delta_s;
+  a->free_beside.false_since_s += delta_s;
   a->hunted_t_s += delta_s;
   a->latch_since_s += delta_s;
   a->latch_last_met_s += delta_s;
@@ -357,7 +373,7 @@ static hm_level raw_level(const hm_alarm a, const hm_estimate *e, const hm_margi
   if (v_ahead >= s->warn_from_kmh - hv_warn) return *reason = HM_REASON_NEAR_HOPF, HM_LEVEL_WARN;
   if (v_ahead >= s->watch_from_kmh - hv_watch)
     return *reason = HM_REASON_APPROACHING_HOPF, HM_LEVEL_WATCH;
-  if (g && g->model_mismatch) return *reason = HM_REASON_MODEL_MISMATCH, HM_LEVEL_WATCH;
+  if (s->model_mismatch) return *reason = HM_REASON_MODEL_MISMATCH, HM_LEVEL_WATCH;
   if (g && g->conicity_valid && g->outside_prior && c->use_conicity_estimate)
     return *reason = HM_REASON_OUTSIDE_PRIOR, HM_LEVEL_WATCH;
   if (s->narrow_peak_ambiguous) return *reason = HM_REASON_NARROW_PEAK, HM_LEVEL_WATCH;
@@ -442,6 +458,31 @@ static double sustained_acceleration(hm_alarm a, double now, double v_kmh) {
   return fmin(fmax(blocks_slope(a), 0.0), HM_ALARM_MAX_ACCEL_KMH_S);
 }
 
+static int sticky(sticky_flag *f, int condition, double now) {
+  if (condition) {
+    f->on = 1;
+    f->false_since_s = NAN;
+  } else if (f->on) {
+    if (isnan(f->false_since_s)) f->false_since_s = now;
+    if (now - f->false_since_s >= HM_ALARM_FLAG_CLEAR_S) f->on = 0;
+  }
+  return f->on;
+}
+
+/* The estimate's use alone (alarm.h): at once the first time, at once dropped, and once dropped taken again only after
+ * its condition has held for HM_ALARM_FLAG_CLEAR_S. */
+static int regained(hm_alarm a, int condition, double now) {
+  if (!condition) {
+    if (a->precise) a->precise_lost = 1;
+    a->precise_since = NAN;
+    return 0;
+  }
+  if (isnan(a->precise_since)) a->precise_since = now;
+  if (a->precise_lost && now - a->precise_since < HM_ALARM_FLAG_CLEAR_S) return 0;
+  a->precise_lost = 0;
+  return 1;
+}
+
 /* WARN from an identified Hopf speed (alarm.h): the point less the larger of the margin and one standard error, the
  * lower half-width (point - low) being z of them. */
 static double warn_below_point(double point_kmh, double low_kmh, double margin_kmh, double z) {
@@ -451,16 +492,21 @@ static double warn_below_point(double point_kmh, double low_kmh, double margin_k
 /* The conicity in use, the Hopf interval and the boundaries at the current speed; the table's status on failure. */
 static hm_status assess(hm_alarm a, const hm_estimate *e, const hm_margin_estimate *g, hm_assessment *s) {
   const hm_alarm_config *c = &a->cfg;
+  const double now = s->time_s;
   const int axle = a->point == HM_POINT_WHEELSET;
   const int have = c->use_conicity_estimate && g && g->conicity_valid && g->hopf_model_valid;
+  /* the margin's flags as the level uses them, held against the provisional window's chatter (alarm.h) */
+  const int mismatch = sticky(&a->mismatch, g && g->model_mismatch, now);
   /* the model-based interval counts from an axle-box sensor on a vehicle that behaves like its model (alarm.h) */
-  const int usable_model = have && axle && !g->model_mismatch;
+  const int usable_model = have && axle && !mismatch;
   const double max_se = a->precise ? HM_ALARM_SE_HYSTERESIS * c->conicity_max_se : c->conicity_max_se;
   const int unconfirmed_change = g && g->n_changes > 0 && g->windows_since_change < 2;
-  /* an estimate enters alone when precise, inside the prior and not a change's first window; otherwise combined with
-   * the prior (the more cautious): one precise but above the prior's range (its Hopf speed lower: worn beyond the
-   * prior), or any with a lightly damped mode held (alarm.h) */
-  const int precise = usable_model && g->conicity_se <= max_se && !g->outside_prior && !unconfirmed_change;
+  /* an estimate enters alone when precise, inside the prior and not a change's first window (once it stopped being
+   * so, only after it has been so again for HM_ALARM_FLAG_CLEAR_S); otherwise combined with the prior (the more
+   * cautious): one precise but above the prior's range (its Hopf speed lower: worn beyond the prior), or any with a
+   * lightly damped mode held (alarm.h) */
+  const int precise = regained(a, usable_model && g->conicity_se <= max_se && !g->outside_prior && !unconfirmed_change,
+                               now);
   const int cautious_precise = usable_model && g->conicity_se <= max_se && g->outside_prior > 0;
   const int usable = precise || cautious_precise || (usable_model && g->near_evidence);
   /* the prior's interval, and the uncertain estimate's where it is the more cautious */
@@ -487,12 +533,17 @@ static hm_status assess(hm_alarm a, const hm_estimate *e, const hm_margin_estima
    * regression has residuals to check it (three windows or more) and a lightly damped mode is held: a zero crossing
    * extrapolated from decay rates of -5..-11 1/s alone is wide (on a ramp from 271 to 301 km/h, 322 [309, ...] for a
    * Hopf speed of 357) and its lower end is no evidence */
-  const int free_alone = g && (g->model_mismatch || !axle);
-  const int free_counts =
-      g && g->hopf_free_valid && (free_alone || (g->n_windows >= HM_ALARM_FREE_MIN_WINDOWS && g->near_evidence));
+  const int free_alone = g && (mismatch || !axle);
+  const int free_valid = g && g->hopf_free_valid;
+  if (free_valid) a->free_low_kmh = g->hopf_free_low_kmh, a->free_high_kmh = g->hopf_free_high_kmh;
+  const int free_beside = sticky(
+      &a->free_beside, free_valid && g->n_windows >= HM_ALARM_FREE_MIN_WINDOWS && g->near_evidence && !free_alone, now);
+  const int free_counts = (free_valid && free_alone) || free_beside; /* (held: its last valid interval) */
+  s->model_mismatch = mismatch;
+  s->hopf_free_used = free_counts;
   if (free_counts) {
-    lo = fmin(lo, g->hopf_free_low_kmh);
-    if (free_alone && g->hopf_free_high_kmh < hi) hi = g->hopf_free_high_kmh;
+    lo = fmin(lo, a->free_low_kmh);
+    if (free_alone && a->free_high_kmh < hi) hi = a->free_high_kmh;
   }
   s->conicity = lambda;
   hm_table_lookup_result b, bo;
@@ -514,7 +565,7 @@ static hm_status assess(hm_alarm a, const hm_estimate *e, const hm_margin_estima
   const double z = g && g->interval_z > 0.0 ? g->interval_z : 1.0;
   s->warn_from_kmh = warn_below_point(from, precise ? s->hopf_low_kmh : from, c->warn_speed_margin_kmh, z);
   if (usable && !precise) {
-    const double lo_e = free_counts ? fmin(g->hopf_model_low_kmh, g->hopf_free_low_kmh) : g->hopf_model_low_kmh;
+    const double lo_e = free_counts ? fmin(g->hopf_model_low_kmh, a->free_low_kmh) : g->hopf_model_low_kmh;
     s->warn_from_kmh = fmin(a->prior_hopf_low_kmh - c->warn_speed_margin_kmh,
                             warn_below_point(g->hopf_model_kmh, lo_e, c->warn_speed_margin_kmh, z));
   }

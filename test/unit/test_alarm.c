@@ -759,6 +759,57 @@ static void anticipation_is_not_defeated_by_notches(void) {
            "WARN at %.2f s smooth, %.2f and %.2f s notched", t_warn[0], t_warn[1], t_warn[2]);
 }
 
+/* Flags that flip with the provisional window (issue #27 item 7; margin.h counts the current stretch's window while it
+ * lasts, replaced every fit): model_mismatch, the model-free interval's window count (its lower end counts from three
+ * windows with a lightly damped mode held) and the estimate's use alone (precise: here outside_prior flipping) each
+ * alternate 2 s on, 2 s off for 60 s, then stay off. References, from the input: the flag raised at its first "on"
+ * (3 s) and kept until HM_ALARM_FLAG_CLEAR_S (20 s) after its last "on" ended (61 s, so cleared at 81 s), the
+ * published interval and model_mismatch changing twice; the estimate's use alone (from the start) dropped at the first
+ * "off" (5 s) and taken again only after 20 s in which it could have been (never while it flips: at 63 + 20 s). Before,
+ * each flipped with every provisional window: 29-30 times. */
+static void provisional_windows_do_not_chatter(void) {
+  const hm_margin_estimate g = identified();
+  hm_margin_estimate lower = g; /* the model-free interval 30 km/h below the model's, valid */
+  lower.hopf_free_valid = 1, lower.near_evidence = 1;
+  lower.hopf_free_kmh = g.hopf_model_kmh - 30.0;
+  lower.hopf_free_low_kmh = g.hopf_model_low_kmh - 30.0;
+  lower.hopf_free_high_kmh = g.hopf_model_high_kmh - 30.0;
+  for (int flag = 0; flag < 3; ++flag) { /* 0 model_mismatch, 1 the model-free window count, 2 outside_prior */
+    hm_alarm a = make();
+    hm_assessment s;
+    const hm_estimate e = estimate(400.0, 0.0);
+    int flips = 0, prev = -1;
+    double first_on = NAN, last_off = NAN;
+    for (int k = 0; k <= 10 * 120; ++k) {
+      const double t = 0.1 * k;
+      const int on = t >= 3.0 && t < 63.0 && ((int)floor((t - 3.0) / 2.0)) % 2 == 0;
+      hm_margin_estimate m = flag == 1 ? lower : g;
+      if (flag == 0) m.model_mismatch = on;
+      if (flag == 1) m.n_windows = on ? 3 : 2;
+      if (flag == 2) m.outside_prior = t >= 3.0 && t < 63.0 && !on ? -1 : 0; /* 0: it may be used alone */
+      HM_CHECK(hm_alarm_update(a, &e, &m, t, &s) == HM_OK, "update");
+      const int shown = flag == 0 ? s.model_mismatch : flag == 1 ? s.hopf_free_used : s.conicity_from_estimate;
+      flips += prev >= 0 && shown != prev;
+      if (prev == 0 && shown == 1 && isnan(first_on)) first_on = t;
+      if (prev == 1 && shown == 0) last_off = t;
+      prev = shown;
+    }
+    static const char *const names[3] = {"model_mismatch", "the model-free window count", "the estimate alone"};
+    printf("  %s flipping every 2 s for 60 s: shown changed %d times, raised at %.1f s, cleared at %.1f s\n",
+           names[flag], flips, first_on, last_off);
+    if (flag < 2) {
+      HM_CHECK(flips == 2 && fabs(first_on - 3.0) < 1e-9 && fabs(last_off - (61.0 + 20.0)) < 0.051,
+               "%s: %d changes, raised at %.1f, cleared at %.1f", names[flag], flips, first_on, last_off);
+      HM_CHECK_DELTA(s.hopf_low_kmh, g.hopf_model_low_kmh, 1e-9, "after: the model's low end");
+    } else {
+      /* used alone from the start; dropped at the first "off" (5 s); used again 20 s after the last "off" ended (63 s) */
+      HM_CHECK(flips == 2 && fabs(last_off - 5.0) < 1e-9 && fabs(first_on - (63.0 + 20.0)) < 0.051,
+               "%s: %d changes, dropped at %.1f, taken again at %.1f", names[flag], flips, last_off, first_on);
+    }
+    hm_alarm_destroy(a);
+  }
+}
+
 /* What the model may not explain (issue #26), with the default prior (0.1358 -+ 0.03: Hopf 464.8-593.8 km/h by the
  * closed form): a precise estimate of 0.08 (Hopf 690 km/h, the dangerous direction) outside the prior raises WATCH
  * and the interval stays the prior's (the more cautious of each end), so at 470 km/h WARN as the prior gives; 0.29
@@ -909,6 +960,7 @@ int main(void) {
   HM_RUN(anticipates_a_sustained_acceleration);
   HM_RUN(anticipation_is_not_defeated_by_notches);
   HM_RUN(what_the_model_may_not_explain);
+  HM_RUN(provisional_windows_do_not_chatter);
   hm_table_destroy(table);
   HM_TEST_EXIT();
 }
