@@ -31,7 +31,10 @@
  *    rates of -5..-11 1/s is wide: 322 [309, ...] for 357 on a ramp from 271 to 301 km/h), its upper end with
  *    model_mismatch or a sensor off the axle box (the lower of each end).
  * The table gives, at the conicity in use and the current speed, the lowest speed with a cycle, the unstable cycle
- * bounding the basin of the stable origin (the edge) and the stable cycle beyond it. Where the origin is unstable at
+ * bounding the basin of the stable origin (the edge) and the stable cycle beyond it; at a conicity outside the table's
+ * range, widened (hm_table_lookup_widened) and said (conicity_outside_table), never the end conicity's taken silently
+ * (issue #27 item 8: at 0.20 on a table ending at 0.16 its 234.5 km/h for a lowest cycle speed of 226.8, its 8.13 mm
+ * for an edge of 7.40 at 400 km/h). Where the origin is unstable at
  * the conicity in use but the speed is still inside the Hopf interval, the edge is taken at the interval's
  * optimistic end (the conicity whose Hopf speed is hopf_high): the amplitude decides.
  *
@@ -226,6 +229,9 @@ typedef struct {
   int conicity_from_prior;          /* the prior's range sets the interval (no estimate, or one too uncertain) */
   int boundaries_valid;             /* 0 with NO_DATA: nothing below is current */
   hm_table_lookup_result boundaries;/* at the conicity in use and the current speed */
+  int conicity_outside_table;       /* +1 / -1: the conicity in use lies above / below the table's range; the boundaries
+                                       are then the widened lookup's (tables.h: the lowest cycle speed and the edge the
+                                       cautious of the end conicity's and the extrapolated), the Hopf speed exact */
   double hopf_low_kmh, hopf_high_kmh; /* the Hopf interval the level uses */
   double warn_from_kmh, watch_from_kmh; /* speeds from which the Hopf interval gives WARN and WATCH (no hysteresis) */
   double anticipation_kmh;          /* added to the speed for those thresholds below an identified interval: the

@@ -383,17 +383,19 @@ static hm_level raw_level(const hm_alarm a, const hm_estimate *e, const hm_margi
   return *reason = HM_REASON_NORMAL, HM_LEVEL_OK;
 }
 
-/* The table's boundaries at (conicity, speed) through cache slot k; the Hopf speed is the closed form's where the
- * conicity lies outside the table (a clamped lookup's would belong to another conicity). */
+/* The table's boundaries at (conicity, speed) through cache slot k. Outside the table's conicities the widened
+ * lookup (tables.h: the cautious of the end conicity's and the extrapolated, not the end's alone; alarm.h); where the
+ * extrapolation has no Hopf speed, the clamped lookup with the closed-form Hopf speed. */
 static hm_status lookup(hm_alarm a, int k, double conicity, double speed_kmh, hm_table_lookup_result *out) {
   if (a->cache[k].valid && a->cache[k].conicity == conicity && a->cache[k].speed_kmh == speed_kmh) {
     *out = a->cache[k].r;
     return HM_OK;
   }
   hm_table_lookup_result r;
-  const hm_status st = hm_table_lookup(a->table, conicity, speed_kmh, &r);
+  hm_status st = hm_table_lookup_widened(a->table, conicity, speed_kmh, &r);
+  if (st == HM_EDOMAIN && isfinite(conicity) && isfinite(speed_kmh)) st = hm_table_lookup(a->table, conicity, speed_kmh, &r);
   if (st != HM_OK) return st;
-  if (r.conicity != conicity) r.hopf_speed_kmh = hm_linear_hopf_kmh(&a->veh, conicity);
+  if (r.conicity != conicity && !r.widened) r.hopf_speed_kmh = hm_linear_hopf_kmh(&a->veh, conicity);
   a->cache[k].valid = 1;
   a->cache[k].conicity = conicity;
   a->cache[k].speed_kmh = speed_kmh;
@@ -549,6 +551,7 @@ static hm_status assess(hm_alarm a, const hm_estimate *e, const hm_margin_estima
   hm_table_lookup_result b, bo;
   hm_status st = lookup(a, 0, lambda, e->speed_kmh, &b);
   if (st != HM_OK) return st;
+  s->conicity_outside_table = b.conicity == lambda ? 0 : lambda > b.conicity ? 1 : -1;
   if (!precise) { /* the table's value at the point is inside the interval it is shown with */
     lo = fmin(lo, b.hopf_speed_kmh - b.error_speed_kmh);
     hi = fmax(hi, b.hopf_speed_kmh + b.error_speed_kmh);

@@ -810,6 +810,46 @@ static void provisional_windows_do_not_chatter(void) {
   }
 }
 
+/* A conicity in use outside the table's range (issue #27 item 8): identified 0.20 +- 0.003 with a table of 0.12-0.16.
+ * References: the family continued directly at 0.20 (test_tables: lowest cycle speed 226.8 km/h, the edge at 399.7 km/h
+ * 7.396 mm, at 252.4 km/h 9.469 mm) and the closed-form Hopf speed (420.7 km/h). The level's boundaries are at or below
+ * them, and the status says so (conicity_outside_table +1; -1 for 0.10 below the table); the end conicity's (234.5 km/h,
+ * 8.13 mm), which the monitor took before, are not. */
+static void conicity_outside_the_table(void) {
+  hm_margin_estimate g = identified();
+  g.conicity = 0.20, g.conicity_low = 0.194, g.conicity_high = 0.206;
+  g.hopf_model_kmh = hopf_closed_form(0.20);
+  g.hopf_model_low_kmh = hopf_closed_form(0.206), g.hopf_model_high_kmh = hopf_closed_form(0.194);
+  const double speeds[2] = {399.7, 252.4}, edges[2] = {7.396e-3, 9.469e-3};
+  for (int k = 0; k < 2; ++k) {
+    hm_alarm a = make_prior(0.0, 0.0);
+    hm_assessment s;
+    const hm_estimate e = estimate(speeds[k], 0.0);
+    HM_CHECK(hm_alarm_update(a, &e, &g, 0.0, &s) == HM_OK && s.conicity_from_estimate && s.conicity == 0.20, "0.20");
+    printf("  0.20 at %.1f km/h: outside %d, Hopf %.2f, lowest cycle %.1f km/h, edge %.3f mm\n", speeds[k],
+           s.conicity_outside_table, s.boundaries.hopf_speed_kmh, s.boundaries.lowest_cycle_speed_kmh,
+           1e3 * s.edge_used_m);
+    HM_CHECK(s.conicity_outside_table == 1 && s.boundaries.widened, "flagged: %d", s.conicity_outside_table);
+    HM_CHECK_REL(s.boundaries.hopf_speed_kmh, hopf_closed_form(0.20), 1e-9, "the Hopf speed at 0.20");
+    HM_CHECK(s.boundaries.lowest_cycle_speed_kmh <= 226.8, "lowest cycle speed %.1f", s.boundaries.lowest_cycle_speed_kmh);
+    HM_CHECK(s.edge_used_m > 0.0 && s.edge_used_m <= edges[k], "edge %.4f mm", 1e3 * s.edge_used_m);
+    hm_alarm_destroy(a);
+  }
+  hm_margin_estimate n = identified();
+  n.conicity = 0.10, n.conicity_low = 0.097, n.conicity_high = 0.103;
+  n.hopf_model_kmh = hopf_closed_form(0.10);
+  n.hopf_model_low_kmh = hopf_closed_form(0.103), n.hopf_model_high_kmh = hopf_closed_form(0.097);
+  hm_alarm a = make_prior(0.08, 0.16);
+  hm_assessment s;
+  const hm_estimate e = estimate(400.0, 0.0);
+  HM_CHECK(hm_alarm_update(a, &e, &n, 0.0, &s) == HM_OK && s.conicity_from_estimate && s.conicity_outside_table == -1,
+           "0.10: from estimate %d, outside %d", s.conicity_from_estimate, s.conicity_outside_table);
+  hm_alarm_destroy(a);
+  a = make();
+  HM_CHECK(hm_alarm_update(a, &e, NULL, 0.0, &s) == HM_OK && s.conicity_outside_table == 0, "inside");
+  hm_alarm_destroy(a);
+}
+
 /* What the model may not explain (issue #26), with the default prior (0.1358 -+ 0.03: Hopf 464.8-593.8 km/h by the
  * closed form): a precise estimate of 0.08 (Hopf 690 km/h, the dangerous direction) outside the prior raises WATCH
  * and the interval stays the prior's (the more cautious of each end), so at 470 km/h WARN as the prior gives; 0.29
@@ -961,6 +1001,7 @@ int main(void) {
   HM_RUN(anticipation_is_not_defeated_by_notches);
   HM_RUN(what_the_model_may_not_explain);
   HM_RUN(provisional_windows_do_not_chatter);
+  HM_RUN(conicity_outside_the_table);
   hm_table_destroy(table);
   HM_TEST_EXIT();
 }
