@@ -504,9 +504,10 @@ def test_estimate_last_line_counts_everything():
             f.write("t_s,accel_mps2\n")
             f.write("".join(f"{i / 2000:.4f},{2.0 * math.sin(2 * math.pi * 14 * i / 2000):.6f}\n" for i in range(n)))
             f.write("nan,1.0\n2.5,1.0\n")  # refused: no time, out of order
-        with open(spd, "w") as f:  # 0 .. 3.0 s at 10 Hz, one value not a number, then three rows after the end
-            f.write("t_s,speed_kmh\n")
-            f.write("".join(f"{i / 10:.1f},{'nan' if i == 5 else '400'}\n" for i in range(31)))
+        with open(spd, "w") as f:  # 0 .. 3.0 s at 10 Hz, one value and one time not a number, three rows after
+            f.write("t_s,speed_kmh\n")  # the end (a row without a time had stopped the speeds after it: NO_DATA)
+            f.write("".join(f"{i / 10:.1f},{'nan' if i == 5 else '400'}\n" + ("nan,400\n" if i == 10 else "")
+                            for i in range(31)))
             f.write("3.5,400\nnan,400\n4.0,400\n")
         out = lines(run("estimate", "--accel", acc, "--speed", spd, "--table", shipped_table(), "--every", "0.5").stdout)
         last = out[-1]
@@ -514,9 +515,10 @@ def test_estimate_last_line_counts_everything():
                                        "rejected_out_of_range", "rejected_out_of_order", "speed_rows",
                                        "speed_updates", "rejected_speeds", "speed_rows_unused")}
         assert counts == {"accel_rows": n + 2, "accel_samples": n, "rejected_samples": 2, "rejected_nonfinite": 1,
-                          "rejected_out_of_range": 0, "rejected_out_of_order": 1, "speed_rows": 34,
-                          "speed_updates": 31, "rejected_speeds": 1, "speed_rows_unused": 3}, counts
+                          "rejected_out_of_range": 0, "rejected_out_of_order": 1, "speed_rows": 35,
+                          "speed_updates": 32, "rejected_speeds": 2, "speed_rows_unused": 3}, counts
         close(last["t_s"], 3.0, 1e-9, "the last line at the last sample's time")
+        assert last["level"] != "NO_DATA" and last["speed_valid"], last
         for key in ("gaps", "samples_lost", "rate_changes"):
             assert last[key] == 0, (key, last[key])
 
