@@ -589,10 +589,19 @@ static hm_status assess(hm_alarm a, const hm_estimate *e, const hm_margin_estima
   return HM_OK;
 }
 
+/* WARN and WATCH from at most basis_kmh less their margins (the published fields agree, alarm.h); warn_risk is not
+ * stated for a WARN speed the interval did not set. */
+static void below(const hm_alarm a, hm_assessment *s, double basis_kmh) {
+  const double warn_from = basis_kmh - a->cfg.warn_speed_margin_kmh;
+  if (warn_from < s->warn_from_kmh) s->warn_from_kmh = warn_from, s->warn_risk = NAN;
+  s->watch_from_kmh = fmin(s->watch_from_kmh, basis_kmh - a->cfg.watch_speed_margin_kmh);
+}
+
 /* Hunting met a criterion at a speed below the interval: the vehicle's Hopf speed (or, after a large disturbance, its
  * lowest cycle speed) may be no higher. The lowest such speed of the latch bounds the interval's lower end, and the
- * WARN and WATCH thresholds below it by their margins, while the ALARM is held and for memory_s after it (alarm.h);
- * the latch is released only below it. */
+ * WARN and WATCH thresholds below it by their margins (also where it lies inside the interval), while the ALARM is
+ * held and for memory_s after it (alarm.h); the latch is released only below it. While held, WARN and WATCH lie below
+ * the interval's lower end by their margins. */
 static void hunted_bound(hm_alarm a, const hm_estimate *e, double now, hm_assessment *s) {
   if (e->rms_exceeded || e->peaks_exceeded || e->displacement_exceeded) {
     if (!a->latched && a->hunted_at_kmh < INFINITY && !(now - a->hunted_t_s <= a->memory_s))
@@ -603,16 +612,15 @@ static void hunted_bound(hm_alarm a, const hm_estimate *e, double now, hm_assess
   if (!a->latched && !(now - a->hunted_t_s <= a->memory_s)) a->hunted_at_kmh = INFINITY;
   s->hunted_at_kmh = a->hunted_at_kmh < INFINITY ? a->hunted_at_kmh : NAN;
   s->hunted_at_s = a->hunted_at_kmh < INFINITY ? a->hunted_t_s : NAN;
-  if (!(a->hunted_at_kmh < INFINITY)) return;
-  /* the thresholds below it by their margins also where it lies inside the interval (above its lower end but below
-   * the WARN speed of an identified point: the published fields agree, alarm.h) */
-  const double warn_from = a->hunted_at_kmh - a->cfg.warn_speed_margin_kmh;
-  if (warn_from < s->warn_from_kmh) s->warn_from_kmh = warn_from, s->warn_risk = NAN;
-  s->watch_from_kmh = fmin(s->watch_from_kmh, a->hunted_at_kmh - a->cfg.watch_speed_margin_kmh);
-  if (!(a->hunted_at_kmh < s->hopf_low_kmh)) return;
-  s->hopf_low_kmh = a->hunted_at_kmh;
-  s->hopf_low_from_hunting = 1;
-  s->warn_risk = NAN; /* the interval read as normal is not what the level uses */
+  if (a->hunted_at_kmh < INFINITY) { /* the thresholds below it by their margins, also inside the interval */
+    below(a, s, a->hunted_at_kmh);
+    if (a->hunted_at_kmh < s->hopf_low_kmh) {
+      s->hopf_low_kmh = a->hunted_at_kmh;
+      s->hopf_low_from_hunting = 1;
+      s->warn_risk = NAN; /* the interval read as normal is not what the level uses */
+    }
+  }
+  if (a->latched) below(a, s, s->hopf_low_kmh); /* during a hold from the held interval's lower end */
 }
 
 hm_status hm_alarm_update(hm_alarm a, const hm_estimate *e, const hm_margin_estimate *g, double now, hm_assessment *out) {

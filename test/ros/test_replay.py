@@ -237,8 +237,8 @@ class Replay(unittest.TestCase):
 
     def test_published_fields_agree(self):
         """Issue #27 item 7: every data status's interval holds its point; a hunted-at speed bounds the lower end, and
-        WARN and WATCH lie below it by their margins (10 and 30 km/h); while latched the release speed is the lower end
-        less the 3 km/h hysteresis, the calm still needed the calm needed (10 s) less the calm so far; a held status's
+        WARN and WATCH lie below it by their margins (10 and 30 km/h); while latched they lie below the lower end by
+        them too, and the release speed is the lower end less the 3 km/h hysteresis, the calm still needed the calm needed (10 s) less the calm so far; a held status's
         reason says it is held and its code is the hold's cause; the stamped alarm carries its status's reason and hold;
         the chart's band spans the status's interval (1 m per 100 km/h from x = 1.5 m)."""
         seq = [m for m in self.data_statuses() if m.boundaries_valid]
@@ -253,6 +253,9 @@ class Replay(unittest.TestCase):
                 self.assertLessEqual(m.watch_from_kmh, m.hunted_at_kmh - 30.0 + 1e-9)
         for m in latched:
             self.assertAlmostEqual(m.hold_release_below_kmh, m.hopf_speed_kmh_low - 3.0, delta=1e-6)
+            if m is not latched[0]:  # (from the update after the one that latched it)
+                self.assertLessEqual(m.warn_from_kmh, m.hopf_speed_kmh_low - 10.0 + 1e-9)
+                self.assertLessEqual(m.watch_from_kmh, m.hopf_speed_kmh_low - 30.0 + 1e-9)
             self.assertAlmostEqual(m.hold_calm_needed_s, 10.0, delta=1e-9)
             self.assertAlmostEqual(m.latch_release_in_s, m.hold_calm_needed_s - m.hold_calm_s, delta=1e-6)
             self.assertTrue(m.hold_cause, m.reason)
