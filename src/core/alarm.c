@@ -623,6 +623,47 @@ static void hunted_bound(hm_alarm a, const hm_estimate *e, double now, hm_assess
   if (a->latched) below(a, s, s->hopf_low_kmh); /* during a hold from the held interval's lower end */
 }
 
+/* The latch (alarm.h) with data: an oscillation ALARM latches (its first cause and time kept); a latched one holds,
+ * with that cause, until the release conditions have held for release_s. */
+static void latch(hm_alarm a, const hm_estimate *e, double now, hm_assessment *s, hm_level *target, hm_reason *reason) {
+  const int oscillation = *target == HM_LEVEL_ALARM && oscillation_reason(*reason);
+  if (a->latched || oscillation) release_conditions(a, e, s);
+  if (oscillation) {
+    if (!a->latched) a->latch_cause = *reason, a->latch_since_s = now;
+    a->latched = 1;
+    a->latch_last_met_s = now;
+    a->calm = 0;
+  } else if (a->latched) {
+    if (s->hold_waits) a->calm = 0;
+    else if (!a->calm) a->calm = 1, a->calm_since = now;
+    if (a->calm && now - a->calm_since >= a->cfg.release_s) {
+      a->latched = 0; /* the hunted-at speed stays a bound for memory_s */
+    } else {
+      *target = HM_LEVEL_ALARM;
+      *reason = a->latch_cause;
+      s->held = 1;
+      if (a->calm) s->hold_waits = HM_HOLD_WAITS_TIME;
+    }
+  }
+  s->latched = a->latched;
+}
+
+/* The hold in numbers (alarm.h): while latched its cause, times, calm so far and needed; else none. */
+static void hold_numbers(const hm_alarm a, double now, hm_assessment *s) {
+  if (a->latched) {
+    s->hold_cause = a->latch_cause;
+    s->hold_since_s = a->latch_since_s;
+    s->hold_last_met_s = a->latch_last_met_s;
+    s->calm_needed_s = a->cfg.release_s;
+    s->calm_s = s->held && a->calm ? now - a->calm_since : 0.0;
+    s->release_in_s = s->calm_needed_s - s->calm_s;
+  } else {
+    s->hold_cause = HM_REASON_STARTUP;
+    s->hold_since_s = s->hold_last_met_s = s->hold_release_below_kmh = s->hold_release_amplitude_m = NAN;
+    s->hold_waits = 0;
+  }
+}
+
 hm_status hm_alarm_update(hm_alarm a, const hm_estimate *e, const hm_margin_estimate *g, double now, hm_assessment *out) {
   if (!a || !e || !out || !isfinite(now)) return HM_EINVAL;
   const hm_alarm_config *c = &a->cfg;
@@ -677,39 +718,9 @@ hm_status hm_alarm_update(hm_alarm a, const hm_estimate *e, const hm_margin_esti
       hm_reason r_ahead;
       if (raw_level(a, &ahead, g, &s, a->level, &r_ahead) >= a->level) target = a->level, reason = a->reason;
     }
-    if (a->latched || (target == HM_LEVEL_ALARM && oscillation_reason(reason))) release_conditions(a, e, &s);
-    if (target == HM_LEVEL_ALARM && oscillation_reason(reason)) {
-      if (!a->latched) a->latch_cause = reason, a->latch_since_s = now;
-      a->latched = 1;
-      a->latch_last_met_s = now;
-      a->calm = 0;
-    } else if (a->latched) {
-      /* held until calm for release_s */
-      if (s.hold_waits) a->calm = 0;
-      else if (!a->calm) a->calm = 1, a->calm_since = now;
-      if (a->calm && now - a->calm_since >= c->release_s) {
-        a->latched = 0; /* the hunted-at speed stays a bound for memory_s */
-      } else {
-        target = HM_LEVEL_ALARM;
-        reason = a->latch_cause;
-        s.held = 1;
-        if (a->calm) s.hold_waits = HM_HOLD_WAITS_TIME;
-      }
-    }
-    s.latched = a->latched;
+    latch(a, e, now, &s, &target, &reason);
   }
-  if (a->latched) { /* the hold in numbers (alarm.h) */
-    s.hold_cause = a->latch_cause;
-    s.hold_since_s = a->latch_since_s;
-    s.hold_last_met_s = a->latch_last_met_s;
-    s.calm_needed_s = c->release_s;
-    s.calm_s = s.held && a->calm ? now - a->calm_since : 0.0;
-    s.release_in_s = s.calm_needed_s - s.calm_s;
-  } else {
-    s.hold_cause = HM_REASON_STARTUP;
-    s.hold_since_s = s.hold_last_met_s = s.hold_release_below_kmh = s.hold_release_amplitude_m = NAN;
-    s.hold_waits = 0;
-  }
+  hold_numbers(a, now, &s);
   /* (with no data the latch is kept: nothing says the oscillation has gone) */
   s.changed = 0;
   if (target >= a->level || target == HM_LEVEL_NO_DATA || a->level == HM_LEVEL_NO_DATA) {
