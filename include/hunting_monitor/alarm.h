@@ -209,7 +209,9 @@ typedef struct {
  * model-free interval's lower end beside the model's (three windows with a lightly damped mode held; its last valid
  * interval is kept meanwhile) are raised at once and cleared only after their condition has been false for this long
  * [s]; the estimate's use alone (conicity_from_estimate), the less cautious reading, is dropped at once and, once
- * dropped, taken again only after its condition has held this long (the first time at once). A stretch gives a new
+ * dropped, taken again only after its condition has held this long (the first time at once; meanwhile it is combined
+ * with the prior, the more cautious of both, never left out: the prior alone had been wholly above the truth where
+ * the wheels had worn beyond it). A stretch gives a new
  * provisional window only after min_window_s (20 s): this is one. */
 #define HM_ALARM_FLAG_CLEAR_S 20.0
 

@@ -504,13 +504,13 @@ static hm_status assess(hm_alarm a, const hm_estimate *e, const hm_margin_estima
   const double max_se = a->precise ? HM_ALARM_SE_HYSTERESIS * c->conicity_max_se : c->conicity_max_se;
   const int unconfirmed_change = g && g->n_changes > 0 && g->windows_since_change < 2;
   /* an estimate enters alone when precise, inside the prior and not a change's first window (once it stopped being
-   * so, only after it has been so again for HM_ALARM_FLAG_CLEAR_S); otherwise combined with the prior (the more
-   * cautious): one precise but above the prior's range (its Hopf speed lower: worn beyond the prior), or any with a
-   * lightly damped mode held (alarm.h) */
-  const int precise = regained(a, usable_model && g->conicity_se <= max_se && !g->outside_prior && !unconfirmed_change,
-                               now);
+   * so, only after it has been so again for HM_ALARM_FLAG_CLEAR_S, meanwhile combined with the prior); otherwise
+   * combined with the prior (the more cautious): one precise but above the prior's range (its Hopf speed lower: worn
+   * beyond the prior), or any with a lightly damped mode held (alarm.h) */
+  const int alone = usable_model && g->conicity_se <= max_se && !g->outside_prior && !unconfirmed_change;
+  const int precise = regained(a, alone, now);
   const int cautious_precise = usable_model && g->conicity_se <= max_se && g->outside_prior > 0;
-  const int usable = precise || cautious_precise || (usable_model && g->near_evidence);
+  const int usable = precise || alone || cautious_precise || (usable_model && g->near_evidence);
   /* the prior's interval, and the uncertain estimate's where it is the more cautious */
   double lambda = c->conicity_fallback, lambda_opt = c->conicity_prior_low;
   double lo = a->prior_hopf_low_kmh, hi = a->prior_hopf_high_kmh;

@@ -765,8 +765,9 @@ static void anticipation_is_not_defeated_by_notches(void) {
  * alternate 2 s on, 2 s off for 60 s, then stay off. References, from the input: the flag raised at its first "on"
  * (3 s) and kept until HM_ALARM_FLAG_CLEAR_S (20 s) after its last "on" ended (61 s, so cleared at 81 s), the
  * published interval and model_mismatch changing twice; the estimate's use alone (from the start) dropped at the first
- * "off" (5 s) and taken again only after 20 s in which it could have been (never while it flips: at 63 + 20 s). Before,
- * each flipped with every provisional window: 29-30 times. */
+ * "off" (5 s) and taken again only after 20 s in which it could have been (never while it flips: at 63 + 20 s),
+ * meanwhile combined with the prior (model_interval_used). Before, each flipped with every provisional window: 29-30
+ * times. */
 static void provisional_windows_do_not_chatter(void) {
   const hm_margin_estimate g = identified();
   hm_margin_estimate lower = g; /* the model-free interval 30 km/h below the model's, valid */
@@ -778,7 +779,7 @@ static void provisional_windows_do_not_chatter(void) {
     hm_alarm a = make();
     hm_assessment s;
     const hm_estimate e = estimate(400.0, 0.0);
-    int flips = 0, prev = -1;
+    int flips = 0, prev = -1, left_out = 0;
     double first_on = NAN, last_off = NAN;
     for (int k = 0; k <= 10 * 120; ++k) {
       const double t = 0.1 * k;
@@ -789,6 +790,8 @@ static void provisional_windows_do_not_chatter(void) {
       if (flag == 2) m.outside_prior = t >= 3.0 && t < 63.0 && !on ? -1 : 0; /* 0: it may be used alone */
       HM_CHECK(hm_alarm_update(a, &e, &m, t, &s) == HM_OK, "update");
       const int shown = flag == 0 ? s.model_mismatch : flag == 1 ? s.hopf_free_used : s.conicity_from_estimate;
+      /* waiting to be used alone again, the estimate is combined with the prior, not left out */
+      if (flag == 2 && m.outside_prior == 0) left_out += !s.model_interval_used;
       flips += prev >= 0 && shown != prev;
       if (prev == 0 && shown == 1 && isnan(first_on)) first_on = t;
       if (prev == 1 && shown == 0) last_off = t;
@@ -805,6 +808,7 @@ static void provisional_windows_do_not_chatter(void) {
       /* used alone from the start; dropped at the first "off" (5 s); used again 20 s after the last "off" ended (63 s) */
       HM_CHECK(flips == 2 && fabs(last_off - 5.0) < 1e-9 && fabs(first_on - (63.0 + 20.0)) < 0.051,
                "%s: %d changes, dropped at %.1f, taken again at %.1f", names[flag], flips, last_off, first_on);
+      HM_CHECK(left_out == 0, "%d statuses left a usable estimate out while it waited", left_out);
     }
     hm_alarm_destroy(a);
   }
