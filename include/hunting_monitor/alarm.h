@@ -303,7 +303,8 @@ void hm_alarm_destroy(hm_alarm alarm);
 void hm_alarm_reset(hm_alarm alarm);
 /* The time line restarted (a clock step, a bag looped; times before are not comparable with times after): a held
  * ALARM stays held with its cause (a latch carries no times that matter) and the hunted-at speed stays a bound (its
- * age counts again from the next update); the level's hold, the calm seen, the speed's trend start again. */
+ * age counts again from the next update); the level's hold, the calm seen, the speed's trend and the margin's flags
+ * held against chatter (HM_ALARM_FLAG_CLEAR_S) start again. */
 void hm_alarm_restart(hm_alarm alarm);
 /* The time line moved by delta_s (a known step): every time the alarm holds moves with it, so ages are kept. */
 void hm_alarm_shift_time(hm_alarm alarm, double delta_s);
