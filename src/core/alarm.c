@@ -501,7 +501,9 @@ static hm_status assess(hm_alarm a, const hm_estimate *e, const hm_margin_estima
   const int mismatch = sticky(&a->mismatch, g && g->model_mismatch, now);
   /* the model-based interval counts from an axle-box sensor on a vehicle that behaves like its model (alarm.h) */
   const int usable_model = have && axle && !mismatch;
-  const double max_se = a->precise ? HM_ALARM_SE_HYSTERESIS * c->conicity_max_se : c->conicity_max_se;
+  /* (the standard error's hysteresis also while the estimate waits to be used alone again) */
+  const double max_se =
+      a->precise || a->precise_lost ? HM_ALARM_SE_HYSTERESIS * c->conicity_max_se : c->conicity_max_se;
   const int unconfirmed_change = g && g->n_changes > 0 && g->windows_since_change < 2;
   /* an estimate enters alone when precise, inside the prior and not a change's first window (once it stopped being
    * so, only after it has been so again for HM_ALARM_FLAG_CLEAR_S, meanwhile combined with the prior); otherwise

@@ -766,8 +766,8 @@ static void anticipation_is_not_defeated_by_notches(void) {
  * (3 s) and kept until HM_ALARM_FLAG_CLEAR_S (20 s) after its last "on" ended (61 s, so cleared at 81 s), the
  * published interval and model_mismatch changing twice; the estimate's use alone (from the start) dropped at the first
  * "off" (5 s) and taken again only after 20 s in which it could have been (never while it flips: at 63 + 20 s),
- * meanwhile combined with the prior (model_interval_used). Before, each flipped with every provisional window: 29-30
- * times. */
+ * meanwhile combined with the prior (model_interval_used; its standard error 0.011, within the hysteresis of the
+ * 0.01 limit once used, as while it was used). Before, each flipped with every provisional window: 29-30 times. */
 static void provisional_windows_do_not_chatter(void) {
   const hm_margin_estimate g = identified();
   hm_margin_estimate lower = g; /* the model-free interval 30 km/h below the model's, valid */
@@ -788,6 +788,7 @@ static void provisional_windows_do_not_chatter(void) {
       if (flag == 0) m.model_mismatch = on;
       if (flag == 1) m.n_windows = on ? 3 : 2;
       if (flag == 2) m.outside_prior = t >= 3.0 && t < 63.0 && !on ? -1 : 0; /* 0: it may be used alone */
+      if (flag == 2) m.conicity_se = t < 3.0 ? 0.009 : 0.011; /* within the standard error's hysteresis once used */
       HM_CHECK(hm_alarm_update(a, &e, &m, t, &s) == HM_OK, "update");
       const int shown = flag == 0 ? s.model_mismatch : flag == 1 ? s.hopf_free_used : s.conicity_from_estimate;
       /* waiting to be used alone again, the estimate is combined with the prior, not left out */
