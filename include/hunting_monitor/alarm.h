@@ -4,7 +4,7 @@
  *
  * The conicity in use and the Hopf interval [hopf_low, hopf_high] the level uses come from what is known:
  *  - identified: the margin's model-based estimate (margin.h) with a standard error of at most conicity_max_se (once
- *    used, up to HM_ALARM_SE_HYSTERESIS times that: an error wandering about the limit as windows come and go does
+ *    within it, up to HM_ALARM_SE_HYSTERESIS times that: an error wandering about the limit as windows come and go does
  *    not switch the interval, and the level, back and forth): its conicity and interval (the conicity -+
  *    interval_z standard errors);
  *  - before that, the prior: conicity_fallback (0: the vehicle's own lambda(0)) within the range the wheels may have
@@ -197,7 +197,7 @@ typedef struct {
  * from windows far below the Hopf speed one standard error reached 28 km/h and WARN came 23 km/h below the truth;
  * WATCH keeps the whole half-width. The risk, Phi(-min(se, 20) / se), is in the status (warn_risk). */
 #define HM_ALARM_WARN_MAX_BELOW_KMH 20.0
-/* An estimate in use stays in use while its standard error is at most this times conicity_max_se. */
+/* A standard error once within conicity_max_se stays within it up to this times conicity_max_se. */
 #define HM_ALARM_SE_HYSTERESIS 1.25
 /* The model-free interval's lower end counts for the level from this many windows on with a lightly damped mode held
  * (and with model_mismatch or a sensor off the axle box). */

@@ -38,7 +38,8 @@ struct hm_alarm_s {
   double hunted_t_s;      /* when (the latest time it was met there or lower); NAN: on a time line that restarted,
                              its age counts from the next update */
   double memory_s;        /* how long a hunted-at speed bounds the interval (hm_alarm_set_memory) */
-  int precise;            /* the estimate was used alone at the last update with data (its hysteresis) */
+  int precise;            /* the estimate was used alone at the last update with data */
+  int se_ok;              /* its standard error was small enough at the last update with data (its hysteresis) */
   int precise_lost;       /* it stopped being used alone: used again once it could have been since precise_since */
   double precise_since;   /* (NAN: it could not be at the last update) */
   sticky_flag mismatch, free_beside; /* model_mismatch, the model-free interval beside the model's (alarm.h) */
@@ -266,7 +267,7 @@ void hm_alarm_restart(hm_alarm a) {
   a->calm = 0;
   a->hunted_t_s = NAN; /* its age counts again from the next update */
   a->latch_since_s = a->latch_last_met_s = NAN;
-  a->precise = a->precise_lost = 0;
+  a->precise = a->precise_lost = a->se_ok = 0;
   a->precise_since = NAN;
   a->mismatch.on = a->free_beside.on = 0;
   a->have_trend = 0;
@@ -501,17 +502,18 @@ static hm_status assess(hm_alarm a, const hm_estimate *e, const hm_margin_estima
   const int mismatch = sticky(&a->mismatch, g && g->model_mismatch, now);
   /* the model-based interval counts from an axle-box sensor on a vehicle that behaves like its model (alarm.h) */
   const int usable_model = have && axle && !mismatch;
-  /* (the standard error's hysteresis also while the estimate waits to be used alone again) */
-  const double max_se =
-      a->precise || a->precise_lost ? HM_ALARM_SE_HYSTERESIS * c->conicity_max_se : c->conicity_max_se;
+  /* the standard error within conicity_max_se, once so within HM_ALARM_SE_HYSTERESIS times it (its own hysteresis,
+   * whatever else keeps the estimate from being used alone) */
+  const double max_se = a->se_ok ? HM_ALARM_SE_HYSTERESIS * c->conicity_max_se : c->conicity_max_se;
+  a->se_ok = usable_model && g->conicity_se <= max_se;
   const int unconfirmed_change = g && g->n_changes > 0 && g->windows_since_change < 2;
   /* an estimate enters alone when precise, inside the prior and not a change's first window (once it stopped being
    * so, only after it has been so again for HM_ALARM_FLAG_CLEAR_S, meanwhile combined with the prior); otherwise
    * combined with the prior (the more cautious): one precise but above the prior's range (its Hopf speed lower: worn
    * beyond the prior), or any with a lightly damped mode held (alarm.h) */
-  const int alone = usable_model && g->conicity_se <= max_se && !g->outside_prior && !unconfirmed_change;
+  const int alone = a->se_ok && !g->outside_prior && !unconfirmed_change;
   const int precise = regained(a, alone, now);
-  const int cautious_precise = usable_model && g->conicity_se <= max_se && g->outside_prior > 0;
+  const int cautious_precise = a->se_ok && g->outside_prior > 0;
   const int usable = precise || alone || cautious_precise || (usable_model && g->near_evidence);
   /* the prior's interval, and the uncertain estimate's where it is the more cautious */
   double lambda = c->conicity_fallback, lambda_opt = c->conicity_prior_low;
