@@ -4,7 +4,7 @@
  *
  * The conicity in use and the Hopf interval [hopf_low, hopf_high] the level uses come from what is known:
  *  - identified: the margin's model-based estimate (margin.h) with a standard error of at most conicity_max_se (once
- *    used, up to HM_ALARM_SE_HYSTERESIS times that: an error wandering about the limit as windows come and go does
+ *    within it, up to HM_ALARM_SE_HYSTERESIS times that: an error wandering about the limit as windows come and go does
  *    not switch the interval, and the level, back and forth): its conicity and interval (the conicity -+
  *    interval_z standard errors);
  *  - before that, the prior: conicity_fallback (0: the vehicle's own lambda(0)) within the range the wheels may have
@@ -31,7 +31,10 @@
  *    rates of -5..-11 1/s is wide: 322 [309, ...] for 357 on a ramp from 271 to 301 km/h), its upper end with
  *    model_mismatch or a sensor off the axle box (the lower of each end).
  * The table gives, at the conicity in use and the current speed, the lowest speed with a cycle, the unstable cycle
- * bounding the basin of the stable origin (the edge) and the stable cycle beyond it. Where the origin is unstable at
+ * bounding the basin of the stable origin (the edge) and the stable cycle beyond it; at a conicity outside the table's
+ * range, widened (hm_table_lookup_widened) and said (conicity_outside_table), never the end conicity's taken silently
+ * (issue #27 item 8: at 0.20 on a table ending at 0.16 its 234.5 km/h for a lowest cycle speed of 226.8, its 8.13 mm
+ * for an edge of 7.40 at 400 km/h). Where the origin is unstable at
  * the conicity in use but the speed is still inside the Hopf interval, the edge is taken at the interval's
  * optimistic end (the conicity whose Hopf speed is hopf_high): the amplitude decides.
  *
@@ -170,26 +173,47 @@ typedef struct {
  * at least 10 s before the wheelset passes 3 mm on a ramp of 0.5 km/h/s, issue #18): the speed thresholds are judged
  * on the speed the acceleration reaches in HM_ALARM_RAISE_LOOKAHEAD_S [s]. Not below the prior's range: its lower end
  * is already the cautious end of the wheels' wear, and anticipating on it as well warned 71 km/h below the Hopf speed
- * of new wheels on a ramp of 0.5 km/h/s (test_monitor_sim). The acceleration is the least of the slopes between the mean
- * speeds of the last HM_ALARM_ACCEL_BLOCKS + 1 blocks of HM_ALARM_ACCEL_BLOCK_S [s] (10 s), 0 unless every one is
- * positive, at most HM_ALARM_MAX_ACCEL_KMH_S (a high-speed train's, about 0.3 m/s^2): a step of the speed signal (a
- * sensor's jump, a simulator's step profile) moves one or two block means and no more, and the speed sensor's noise
- * (0.3 km/h r.m.s. over blocks of 10-50 samples) moves a slope by about 0.03 km/h/s (under 1 km/h ahead). */
+ * of new wheels on a ramp of 0.5 km/h/s (test_monitor_sim). The acceleration is the least-squares slope of the mean
+ * speeds of blocks of HM_ALARM_ACCEL_BLOCK_S [s] over the last HM_ALARM_ACCEL_SPAN_S [s] (once the blocks span
+ * HM_ALARM_ACCEL_MIN_SPAN_S), clamped to 0 and HM_ALARM_MAX_ACCEL_KMH_S (a high-speed train's, about 0.3 m/s^2): a
+ * driver's notches (5 s at 1 km/h/s, 5 s held; or 10 and 10) give their mean acceleration to 4%, where the least of
+ * the slopes between consecutive blocks over 10 s, as until issue #27, gave 0 (WARN 15-20 s later than on a smooth
+ * ramp of the same mean). A step of the speed signal (a sensor's jump) is no movement: a change between two updates of
+ * more than HM_ALARM_STEP_RATE_KMH_S (beyond any train's traction or braking) times their interval plus
+ * HM_ALARM_STEP_NOISE_KMH (ten times the speed sensor's 0.3 km/h r.m.s.) starts the blocks again, as a time step back
+ * or a silence of HM_ALARM_ACCEL_SILENCE_S [s] does. The sensor's noise moves the slope by about 0.002 km/h/s (0.04
+ * km/h ahead). A simulator's step profile (moves of 0.5-20 km/h/s) is a movement: its anticipation outlasts the move
+ * by up to the span, as a notch's must. */
 #define HM_ALARM_RAISE_LOOKAHEAD_S 20.0
 #define HM_ALARM_ACCEL_BLOCK_S 2.5
-#define HM_ALARM_ACCEL_BLOCKS 4u
+#define HM_ALARM_ACCEL_SPAN_S 30.0
+#define HM_ALARM_ACCEL_MIN_SPAN_S 20.0
+#define HM_ALARM_ACCEL_MAX_BLOCKS 16u
 #define HM_ALARM_MAX_ACCEL_KMH_S 1.0
+#define HM_ALARM_STEP_RATE_KMH_S 5.0
+#define HM_ALARM_STEP_NOISE_KMH 3.0
+#define HM_ALARM_ACCEL_SILENCE_S 10.0
 /* WARN below an identified point by one standard error, but not by more than this [km/h] (or the margin, if larger):
  * from windows far below the Hopf speed one standard error reached 28 km/h and WARN came 23 km/h below the truth;
  * WATCH keeps the whole half-width. The risk, Phi(-min(se, 20) / se), is in the status (warn_risk). */
 #define HM_ALARM_WARN_MAX_BELOW_KMH 20.0
-/* An estimate in use stays in use while its standard error is at most this times conicity_max_se. */
+/* A standard error once within conicity_max_se stays within it up to this times conicity_max_se. */
 #define HM_ALARM_SE_HYSTERESIS 1.25
 /* The model-free interval's lower end counts for the level from this many windows on with a lightly damped mode held
  * (and with model_mismatch or a sensor off the axle box). */
 #define HM_ALARM_FREE_MIN_WINDOWS 3u
 /* WATCH for an ambiguous narrow peak (HM_REASON_NARROW_PEAK) while the latest such window ended this recently [s]. */
 #define HM_ALARM_NARROW_HOLD_S 60.0
+/* The margin counts the current steady stretch as a provisional window, replaced at every fit (margin.h, monitor.h),
+ * so its flags may flip from one fit to the next. The level holds them (issue #27 item 7): model_mismatch and the
+ * model-free interval's lower end beside the model's (three windows with a lightly damped mode held; its last valid
+ * interval is kept meanwhile) are raised at once and cleared only after their condition has been false for this long
+ * [s]; the estimate's use alone (conicity_from_estimate), the less cautious reading, is dropped at once and, once
+ * dropped, taken again only after its condition has held this long (the first time at once; meanwhile it is combined
+ * with the prior, the more cautious of both, never left out: the prior alone had been wholly above the truth where
+ * the wheels had worn beyond it). A stretch gives a new
+ * provisional window only after min_window_s (20 s): this is one. */
+#define HM_ALARM_FLAG_CLEAR_S 20.0
 
 /* Defaults: 0.5, 10 km/h, 30 km/h, 3 km/h, 0.1, 3 s, estimate used up to a standard error of 0.01, fallback 0
  * (the vehicle's), prior 0 / 0 (the fallback -+ 0.03), release after 10 s below half the displacement limit. */
@@ -207,11 +231,16 @@ typedef struct {
   int conicity_from_prior;          /* the prior's range sets the interval (no estimate, or one too uncertain) */
   int boundaries_valid;             /* 0 with NO_DATA: nothing below is current */
   hm_table_lookup_result boundaries;/* at the conicity in use and the current speed */
+  int conicity_outside_table;       /* +1 / -1: the conicity in use lies above / below the table's range; the boundaries
+                                       are then the widened lookup's (tables.h: the lowest cycle speed and the edge the
+                                       cautious of the end conicity's and the extrapolated), the Hopf speed exact */
   double hopf_low_kmh, hopf_high_kmh; /* the Hopf interval the level uses */
   double warn_from_kmh, watch_from_kmh; /* speeds from which the Hopf interval gives WARN and WATCH (no hysteresis) */
   double anticipation_kmh;          /* added to the speed for those thresholds below an identified interval: the
                                        sustained acceleration times HM_ALARM_RAISE_LOOKAHEAD_S (0 when not accelerating
                                        or on the prior) */
+  int model_mismatch;               /* the margin's model_mismatch as the level uses it (held: below) */
+  int hopf_free_used;             /* the model-free interval's lower end entered the level (held: below) */
   int model_interval_used;          /* the model-based interval entered the level: an estimate (alone or with the prior),
                                        from an axle-box sensor (measurement point wheelset), the vehicle behaving like
                                        its model (no model_mismatch) */
@@ -232,7 +261,36 @@ typedef struct {
   int latched;                      /* an oscillation ALARM held until the oscillation stays calm and the speed drops */
   double release_in_s;              /* calm still needed [s] (release_s while the oscillation or the speed is not
                                        calm yet); 0 when not latched */
+  /* The hold in numbers (issue #27 item 7), while latched (else the causes HM_REASON_STARTUP, the times and speeds
+   * NAN, the seconds 0): */
+  int held;                         /* the level is ALARM only because the latch holds it (no oscillation criterion
+                                       met now, or no current data): reason is then hold_cause */
+  hm_reason hold_cause;             /* what latched the ALARM (the first oscillation reason of the episode) */
+  double hold_since_s;              /* when it latched [s] (NAN after a restarted time line) */
+  double hold_last_met_s;           /* the latest time the oscillation met a criterion, or was beyond the edge [s] */
+  double hold_release_below_kmh;    /* the calm counts only below this speed: hopf_low_kmh less hysteresis_kmh (NAN
+                                       without current boundaries) */
+  double hold_release_amplitude_m;  /* ... with the displacement amplitude below this and no criterion met */
+  double calm_s, calm_needed_s;     /* calm so far and calm needed for the release (release_s) [s] */
+  unsigned hold_waits;              /* what the release waits for: HM_HOLD_WAITS_* bits */
+  double hunted_at_s;               /* when the oscillation met a criterion at hunted_at_kmh (NAN: none) */
+  double time_s;                    /* the update's time [s] */
+  double speed_kmh;                 /* the speed judged (the estimate's; 0 without a current one) */
 } hm_assessment;
+
+/* What a held ALARM's release waits for (hm_assessment.hold_waits). */
+#define HM_HOLD_WAITS_SPEED 1u       /* the speed at or above hold_release_below_kmh */
+#define HM_HOLD_WAITS_OSCILLATION 2u /* a criterion met, or the amplitude at or above hold_release_amplitude_m */
+#define HM_HOLD_WAITS_DATA 4u        /* no current acceleration or speed: the calm is seen only with data */
+#define HM_HOLD_WAITS_TIME 8u        /* calm, counting to calm_needed_s */
+
+/* The status's reason in words, one line (for the CLI's JSON, the node's messages, diagnostics and rviz's lamp): the
+ * reason's sentence (hm_reason_text); while the level is held, that it is held, its cause and when, and the release
+ * condition in numbers, e.g. "held (sliding r.m.s. criterion exceeded at 2.0 s, last met at 298.0 s): hunting seen
+ * down to 231.9 km/h at 298.0 s; releases below 228.9 km/h after 10 s calm (calm 0.0 s: waits for the speed, 230.0
+ * km/h)". Times from t_origin_s ("at 298.0 s"), or with t_origin_s NAN as ages before the update ("12.0 s ago").
+ * Writes at most len bytes, terminated when len > 0; returns the whole text's length (as snprintf). */
+size_t hm_assessment_reason_text(const hm_assessment *s, double t_origin_s, char *buf, size_t len);
 
 typedef struct hm_alarm_s *hm_alarm;
 
@@ -245,7 +303,8 @@ void hm_alarm_destroy(hm_alarm alarm);
 void hm_alarm_reset(hm_alarm alarm);
 /* The time line restarted (a clock step, a bag looped; times before are not comparable with times after): a held
  * ALARM stays held with its cause (a latch carries no times that matter) and the hunted-at speed stays a bound (its
- * age counts again from the next update); the level's hold, the calm seen, the speed's trend start again. */
+ * age counts again from the next update); the level's hold, the calm seen, the speed's trend and the margin's flags
+ * held against chatter (HM_ALARM_FLAG_CLEAR_S) start again. */
 void hm_alarm_restart(hm_alarm alarm);
 /* The time line moved by delta_s (a known step): every time the alarm holds moves with it, so ages are kept. */
 void hm_alarm_shift_time(hm_alarm alarm, double delta_s);

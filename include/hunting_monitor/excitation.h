@@ -42,8 +42,8 @@ double hm_track_at(const hm_track track, double s_m);
 double hm_track_rms_m(const hm_track track);
 double hm_track_spectrum_rms_m(double wavelength_min_m, double wavelength_max_m, double scale);
 
-/* Points of a piecewise-linear speed profile at most. */
-#define HM_SPEED_PROFILE_MAX 16
+/* Points of a piecewise-linear speed profile at most (a notched ramp of 5 s notches over 120 km/h takes 49). */
+#define HM_SPEED_PROFILE_MAX 64
 
 typedef struct {
   hm_model model;                /* vehicle; its speed is set from the profile at each evaluation */

@@ -86,14 +86,27 @@ typedef struct {
   int has_stable_outer;         /* a stable cycle exists beyond the edge (hunting stays bounded there) */
   double stable_outer_amp_m;    /* its amplitude */
   int clamped;                  /* the conicity or speed was outside the table and was clamped */
+  int widened;                  /* the conicity was outside the table: hm_table_lookup_widened's cautious reading */
   int consistent;               /* both neighbouring conicities have the same cycles (count, edge, outer) here */
   double neighbour_spread_m;    /* largest difference of the neighbours' amplitudes (a local error indicator) */
   double error_speed_kmh;       /* stated interpolation error of the speeds (max of the table's two) */
   double error_amp_m;           /* stated interpolation error of the amplitudes where consistent */
 } hm_table_lookup_result;
 
-/* Boundaries at (conicity, speed). No allocation. HM_EDOMAIN for non-finite input. */
+/* Boundaries at (conicity, speed). No allocation. HM_EDOMAIN for non-finite input. Outside the table's conicities the
+ * end conicity's boundaries (clamped), its Hopf speed included: see hm_table_lookup_widened. */
 hm_status hm_table_lookup(const hm_table t, double conicity, double speed_kmh, hm_table_lookup_result *out);
+/* The same inside the table; outside its conicities (issue #27 item 8) the cautious reading, widened, not the end
+ * conicity's: the Hopf speed extrapolated along the end interval (exact: 1/V^2 is affine in lambda); three readings
+ * of the cycles at this speed, (a) the end conicity's own, (b) its family at this conicity's fraction of the Hopf
+ * speed (Klingel), (c) the end interval extrapolated; the lowest cycle speed and the edge (the unstable cycle) the
+ * least of (a) and of (b) and (c) less their difference, the stable outer cycle the largest so (the stated errors
+ * the table's: the Hopf speed is exact, the rest widened already); clamped and widened set, conicity the end's. (On the table 0.12-0.16: at 0.20 and 0.25 the
+ * lowest cycle speed 186.2 and 141.0 km/h for the continuation's 226.8 and 218.2, where the end's is 234.5; the edge
+ * at 0.95 of the Hopf speed 7.35 and 7.23 mm for 7.40 and 7.33, the end's 8.13 and 8.52: test_tables. Cautious, and
+ * far from exact that far out.) The end conicity's edge counts only below its own Hopf speed. A speed outside the
+ * table's is clamped. HM_EDOMAIN for non-finite input, or a conicity whose extrapolated Hopf speed does not exist. */
+hm_status hm_table_lookup_widened(const hm_table t, double conicity, double speed_kmh, hm_table_lookup_result *out);
 
 /* The stiffnesses [MN/m] of the vehicle the table was made for (a user checks them against its vehicle). */
 void hm_table_vehicle(const hm_table t, double *kx_mn_m, double *ky_mn_m);

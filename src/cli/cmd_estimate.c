@@ -40,7 +40,13 @@ static double inferred_rate(const double *d, size_t n) {
   return 1.0 / dt[m / 2];
 }
 
-static void write_line(const hm_monitor_status *st, double t) {
+/* What the tool read, beside what the monitor counted (hm_estimate's counters). */
+typedef struct {
+  unsigned long accel_rows, speed_rows; /* data rows read from the files */
+  unsigned long speed_rows_unused;      /* speed rows after the acceleration's last sample: not given to the monitor */
+} read_counts;
+
+static void write_line(const hm_monitor_status *st, double t, const read_counts *rc) {
   const hm_estimate *e = &st->estimate;
   const hm_assessment *s = &st->assessment;
   const hm_margin_estimate *g = &st->margin;
@@ -51,10 +57,23 @@ static void write_line(const hm_monitor_status *st, double t) {
   jw_number(&w, "t_s", t);
   jw_string(&w, "level", hm_level_name(s->level));
   jw_int(&w, "reason_code", (long)s->reason);
-  jw_string(&w, "reason", hm_reason_text(s->reason));
+  char reason[512];
+  hm_assessment_reason_text(s, 0.0, reason, sizeof reason); /* with a hold's cause, times and release condition */
+  jw_string(&w, "reason", reason);
   jw_bool(&w, "level_changed", s->changed);
   jw_bool(&w, "latched", s->latched);
   jw_number(&w, "release_in_s", s->latched ? s->release_in_s : 0.0);
+  /* the hold in numbers (alarm.h) */
+  jw_bool(&w, "held", s->held);
+  jw_int(&w, "hold_cause_code", (long)s->hold_cause);
+  jw_string(&w, "hold_cause", s->latched ? hm_reason_text(s->hold_cause) : "");
+  jw_number(&w, "hold_since_s", s->hold_since_s);
+  jw_number(&w, "hold_last_met_s", s->hold_last_met_s);
+  jw_number(&w, "hold_release_below_kmh", s->hold_release_below_kmh);
+  jw_number(&w, "hold_release_amplitude_m", s->hold_release_amplitude_m);
+  jw_number(&w, "calm_s", s->calm_s);
+  jw_number(&w, "calm_needed_s", s->calm_needed_s);
+  jw_int(&w, "hold_waits", (long)s->hold_waits);
   jw_bool(&w, "speed_valid", e->speed_valid);
   jw_number(&w, "speed_kmh", e->speed_kmh);
   jw_bool(&w, "accel_valid", e->accel_valid);
@@ -110,7 +129,9 @@ static void write_line(const hm_monitor_status *st, double t) {
   jw_number(&w, "hopf_free_kmh", g->hopf_free_valid ? g->hopf_free_kmh : NAN);
   jw_number(&w, "hopf_free_kmh_low", g->hopf_free_valid ? g->hopf_free_low_kmh : NAN);
   jw_number(&w, "hopf_free_kmh_high", g->hopf_free_valid ? g->hopf_free_high_kmh : NAN);
-  jw_bool(&w, "model_mismatch", g->model_mismatch);
+  /* as the level uses it (held against the provisional window's chatter, alarm.h), and as the windows say now */
+  jw_bool(&w, "model_mismatch", s->boundaries_valid ? s->model_mismatch : g->model_mismatch);
+  jw_bool(&w, "model_mismatch_windows", g->model_mismatch);
   jw_number(&w, "birge_ratio", g->birge_ratio);
   jw_int(&w, "misfit_windows", (long)g->n_misfits);
   jw_int(&w, "conicity_changes", (long)g->n_changes);
@@ -122,6 +143,7 @@ static void write_line(const hm_monitor_status *st, double t) {
   jw_bool(&w, "conicity_from_estimate", b && s->conicity_from_estimate);
   jw_bool(&w, "conicity_from_prior", b && s->conicity_from_prior);
   jw_bool(&w, "model_interval_used", b && s->model_interval_used);
+  jw_bool(&w, "hopf_free_used", b && s->hopf_free_used);
   jw_number(&w, "hopf_kmh", b ? s->boundaries.hopf_speed_kmh : NAN);
   jw_number(&w, "hopf_kmh_low", b ? s->hopf_low_kmh : NAN);
   jw_number(&w, "hopf_kmh_high", b ? s->hopf_high_kmh : NAN);
@@ -129,9 +151,11 @@ static void write_line(const hm_monitor_status *st, double t) {
   jw_number(&w, "watch_from_kmh", b ? s->watch_from_kmh : NAN);
   jw_number(&w, "warn_risk", b ? s->warn_risk : NAN);
   jw_number(&w, "hunted_at_kmh", b ? s->hunted_at_kmh : NAN);
+  jw_number(&w, "hunted_at_s", b ? s->hunted_at_s : NAN);
   jw_bool(&w, "hopf_low_from_hunting", b && s->hopf_low_from_hunting);
   jw_number(&w, "anticipation_kmh", b ? s->anticipation_kmh : NAN);
   jw_number(&w, "lowest_cycle_kmh", b ? s->boundaries.lowest_cycle_speed_kmh : NAN);
+  jw_int(&w, "conicity_outside_table", b ? (long)s->conicity_outside_table : 0L); /* boundaries widened (tables.h) */
   jw_number(&w, "margin_hopf_kmh", b ? s->margin_hopf_kmh : NAN);
   jw_number(&w, "margin_lowest_cycle_kmh", b ? s->margin_lowest_cycle_kmh : NAN);
   jw_number(&w, "unstable_cycle_amplitude_m", b && s->edge_used_m > 0.0 ? s->edge_used_m : NAN);
@@ -142,11 +166,21 @@ static void write_line(const hm_monitor_status *st, double t) {
   jw_int(&w, "consecutive_peaks", (long)e->consecutive_peaks);
   jw_bool(&w, "peaks_exceeded", e->peaks_exceeded);
   jw_bool(&w, "displacement_exceeded", e->displacement_exceeded);
+  /* every input counter (estimator.h), the last line's at the end of the data */
+  jw_int(&w, "accel_rows", (long)rc->accel_rows);
+  jw_int(&w, "accel_samples", (long)e->n_samples);
   jw_int(&w, "rejected_samples", (long)(e->n_rejected_nonfinite + e->n_rejected_range + e->n_rejected_order));
+  jw_int(&w, "rejected_nonfinite", (long)e->n_rejected_nonfinite);
+  jw_int(&w, "rejected_out_of_range", (long)e->n_rejected_range);
+  jw_int(&w, "rejected_out_of_order", (long)e->n_rejected_order);
   jw_int(&w, "gaps", (long)e->n_gaps);
   jw_int(&w, "samples_lost", (long)e->n_samples_lost);
   jw_number(&w, "samples_lost_fraction", e->loss_fraction);
+  jw_int(&w, "rate_changes", (long)e->n_rate_changes);
+  jw_int(&w, "speed_rows", (long)rc->speed_rows);
+  jw_int(&w, "speed_updates", (long)e->n_speed_updates);
   jw_int(&w, "rejected_speeds", (long)e->n_speed_rejected);
+  jw_int(&w, "speed_rows_unused", (long)rc->speed_rows_unused);
   jw_end_object(&w);
   jw_finish(&w);
 }
@@ -188,26 +222,31 @@ static int load_settings(const cli_args *a, const double *acc, size_t n_acc, hm_
 
 enum { HEAD_ROWS = 2001 }; /* rows read ahead to infer the sample rate */
 
-/* The speed file's rows up to time t into the monitor (one row of look-ahead in *next, *have_next). */
-static int push_speeds_until(cli_csv *c, double t, double *next, int *have_next, hm_monitor mon) {
-  while (*have_next && next[0] <= t) {
-    hm_monitor_push_speed(mon, next[0], next[1]);
-    const int r = cli_csv_next(c, next);
-    if (r < 0) return 1;
-    *have_next = r == 1;
-  }
-  return 0;
-}
-
 typedef struct {
   hm_monitor mon;
   const hm_vehicle *veh;
   double every, v_const, next_out, t_written, t_last;
-  unsigned long i;
+  unsigned long i, since_line; /* acceleration rows, and rows since the last line written */
   cli_csv *spd;
   double spd_next[2];
   int spd_have;
+  read_counts counts;
 } run_state;
+
+/* The speed file's rows up to time t into the monitor (one row of look-ahead in r->spd_next; the first was read and
+ * counted before; a row without a finite time at once, for the monitor to refuse and count); with t infinite the
+ * rest of the file, counted as unused. */
+static int push_speeds_until(run_state *r, double t) {
+  while (r->spd_have && !(r->spd_next[0] > t)) {
+    if (isfinite(t)) hm_monitor_push_speed(r->mon, r->spd_next[0], r->spd_next[1]);
+    else ++r->counts.speed_rows_unused;
+    const int k = cli_csv_next(r->spd, r->spd_next);
+    if (k < 0) return 1;
+    r->spd_have = k == 1;
+    r->counts.speed_rows += (unsigned long)r->spd_have;
+  }
+  return 0;
+}
 
 /* The table's refinement as the node does it, but at once (offline nothing waits): the exact family where the
  * monitor wants one (monitor.h). */
@@ -224,19 +263,22 @@ static void refine_table(run_state *r) {
 static int process_row(run_state *r, const double *row, int last_row) {
   const double t = row[0];
   if (r->spd) {
-    if (push_speeds_until(r->spd, t, r->spd_next, &r->spd_have, r->mon)) return 1;
+    if (push_speeds_until(r, t)) return 1;
   } else if (r->i % 10 == 0) {
     hm_monitor_push_speed(r->mon, t, r->v_const);
   }
   ++r->i;
+  ++r->since_line;
+  r->counts.accel_rows = r->i;
   hm_monitor_push_accel(r->mon, t, row[1]);
   if (isfinite(t)) r->t_last = fmax(r->t_last, t);
   if (!isfinite(r->next_out) && isfinite(t)) r->next_out = t + r->every;
   hm_monitor_status st;
   if (isfinite(t) && (t >= r->next_out || last_row) && hm_monitor_update(r->mon, t, &st) == HM_OK) {
     refine_table(r);
-    write_line(&st, t);
+    write_line(&st, t, &r->counts);
     r->t_written = t;
+    r->since_line = 0;
     if (t >= r->next_out) r->next_out = t + r->every - fmod(t - r->next_out, r->every);
   }
   return 0;
@@ -275,7 +317,7 @@ int cmd_estimate(const cli_args *a) {
             n_head == 0 ? "no samples (only a header)" : "fewer than two samples with a finite time stamp");
     rc = 1;
   }
-  run_state run = {NULL, &veh, every, v_const, NAN, -INFINITY, -INFINITY, 0, NULL, {0.0, 0.0}, 0};
+  run_state run = {NULL, &veh, every, v_const, NAN, -INFINITY, -INFINITY, 0, 0, NULL, {0.0, 0.0}, 0, {0, 0, 0}};
   if (rc == 0 && speed_path) {
     rc = cli_csv_open(&spd, speed_path, 2, 1);
     spd_open = rc == 0;
@@ -286,6 +328,7 @@ int cmd_estimate(const cli_args *a) {
     if (rc == 0) {
       const int s = cli_csv_next(&spd, run.spd_next);
       run.spd_have = s == 1;
+      run.counts.speed_rows = (unsigned long)run.spd_have;
       if (s < 0) rc = 1;
       if (s == 0) {
         fprintf(stderr, "hunting estimate: %s: no samples (only a header)\n", speed_path);
@@ -313,9 +356,12 @@ int cmd_estimate(const cli_args *a) {
   for (size_t i = 0; rc == 0 && i < n_head; ++i) rc = process_row(&run, &head[2 * i], ended && i + 1 == n_head);
   double row[2];
   while (rc == 0 && !ended && (r = cli_csv_next(&acc, row)) != 0) rc = r < 0 ? 1 : process_row(&run, row, 0);
-  if (rc == 0 && isfinite(run.t_last) && run.t_written < run.t_last) { /* one line at the end of the data */
+  if (rc == 0 && run.spd) rc = push_speeds_until(&run, INFINITY); /* the rest, after the acceleration's end */
+  /* one line at the end of the data: its counters are the whole run's (rows refused after the last line included) */
+  if (rc == 0 && isfinite(run.t_last) && (run.t_written < run.t_last || run.since_line > 0 ||
+                                          run.counts.speed_rows_unused > 0)) {
     hm_monitor_status st;
-    if (hm_monitor_update(run.mon, run.t_last, &st) == HM_OK) write_line(&st, run.t_last);
+    if (hm_monitor_update(run.mon, run.t_last, &st) == HM_OK) write_line(&st, run.t_last, &run.counts);
   }
   /* a run that could use no speed or no acceleration is an error, whatever it printed (every line NO_DATA) */
   hm_monitor_status end;

@@ -90,6 +90,7 @@ const cli_option table_lookup_opts[] = {
     {"table", "FILE", "boundary table written by 'hunting tables' (required)"},
     {"conicity", "L", "equivalent conicity lambda(0) (required)"},
     {"v", "KM/H", "running speed (required)"},
+    {"widen", NULL, "outside the table's conicities: the cautious reading (tables.h), not an error"},
     {"help", NULL, "show this help"},
     {NULL, NULL, NULL}};
 
@@ -108,14 +109,35 @@ int cmd_table_lookup(const cli_args *a) {
     fprintf(stderr, "hunting: %s: %s\n", path, err[0] ? err : hm_status_str(st));
     return 1;
   }
+  /* outside the table a lookup would clamp (the end conicity's boundaries, issue #27): refused, or with --widen the
+   * cautious reading */
   hm_table_lookup_result r;
-  st = hm_table_lookup(t, conicity, v_kmh, &r);
+  double c_min = 0.0, c_max = 0.0;
+  hm_table_size(t, &c_min, &c_max);
+  const int outside = conicity < c_min || conicity > c_max, widen = cli_has(a, "widen");
+  st = widen ? hm_table_lookup_widened(t, conicity, v_kmh, &r) : hm_table_lookup(t, conicity, v_kmh, &r);
   hm_table_destroy(t);
+  if (st == HM_EDOMAIN && widen && isfinite(conicity)) {
+    fprintf(stderr, "hunting table-lookup: conicity %g: the table's extrapolation (%g..%g) has no Hopf speed there\n",
+            conicity, c_min, c_max);
+    return 1;
+  }
   if (st != HM_OK) return cli_fail_status("lookup", st);
+  if (outside && !widen) {
+    fprintf(stderr, "hunting table-lookup: conicity %g is outside the table's %g..%g (the lookup would give the end "
+                    "conicity's boundaries): refused; --widen gives the cautious reading\n", conicity, c_min, c_max);
+    return 1;
+  }
+  if (r.clamped && !outside) {
+    fprintf(stderr, "hunting table-lookup: --v %g km/h is outside the table's speeds (the lookup would clamp it): "
+                    "refused\n", v_kmh);
+    return 1;
+  }
   json_writer w;
   jw_init(&w, stdout);
   jw_object(&w, NULL);
-  jw_number(&w, "conicity", r.conicity);
+  jw_number(&w, "conicity", conicity);
+  jw_number(&w, "table_conicity", r.conicity); /* the query's, or with --widen outside the table its end's */
   jw_number(&w, "v_kmh", v_kmh);
   jw_number(&w, "hopf_kmh", r.hopf_speed_kmh);
   jw_number(&w, "l1", r.l1);
@@ -130,6 +152,7 @@ int cmd_table_lookup(const cli_args *a) {
   else
     jw_number(&w, "stable_cycle_amplitude_m", NAN);
   jw_bool(&w, "clamped", r.clamped);
+  jw_bool(&w, "widened", r.widened);
   jw_bool(&w, "consistent", r.consistent);
   jw_number(&w, "neighbour_spread_m", r.neighbour_spread_m);
   jw_number(&w, "error_speed_kmh", r.error_speed_kmh);

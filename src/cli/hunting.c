@@ -125,7 +125,7 @@ static int cmd_eig(const cli_args *a) {
 static const cli_option simulate_opts[] = {
     {"v", "KM/H", "running speed (required; the start speed with --v-end)"},
     {"v-end", "KM/H", "ramp the speed linearly from --v to this over --t"},
-    {"profile", "T:V,T:V,...", "a speed profile instead (s:km/h, linear between, from 0 s; up to 16 points; --v not needed)"},
+    {"profile", "T:V,T:V,...", "a speed profile instead (s:km/h, linear between, from 0 s; up to 64 points; --v not needed)"},
     {"x0", "Y,DY,PSI,DPSI", "initial state [m, m/s, rad, rad/s] (default 0.001,0,0,0)"},
     {"t", "SECONDS", "simulated time (default 10)"},
     {"dt-out", "SECONDS", "output interval, dense output of the integrator (default 0.001)"},

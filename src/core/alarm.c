@@ -2,11 +2,18 @@
 #include "hunting_monitor/alarm.h"
 
 #include <math.h>
+#include <stdarg.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
 #include "hunting_monitor/linear.h"
+
+/* A flag raised at once and cleared only after its condition has been false for HM_ALARM_FLAG_CLEAR_S (alarm.h). */
+typedef struct {
+  int on;
+  double false_since_s; /* NAN: the condition held at the last update */
+} sticky_flag;
 
 struct hm_alarm_s {
   hm_alarm_config cfg;            /* fallback and prior resolved for the vehicle */
@@ -19,7 +26,9 @@ struct hm_alarm_s {
   int lower_pending;      /* the conditions for a lower level hold since lower_since */
   double lower_since;
   int latched;            /* an oscillation ALARM held (alarm.h) */
-  hm_reason latch_reason;
+  hm_reason latch_cause;  /* what latched it, when, and the latest time the oscillation met a criterion (or was beyond
+                             the edge) since; NAN: on a time line that restarted */
+  double latch_since_s, latch_last_met_s;
   int calm;               /* the release conditions hold since calm_since */
   double calm_since;
   double displacement_limit_m; /* the displacement criterion's limit (0: off) */
@@ -29,13 +38,19 @@ struct hm_alarm_s {
   double hunted_t_s;      /* when (the latest time it was met there or lower); NAN: on a time line that restarted,
                              its age counts from the next update */
   double memory_s;        /* how long a hunted-at speed bounds the interval (hm_alarm_set_memory) */
-  int precise;            /* the estimate was used alone at the last update with data (its hysteresis) */
+  int precise;            /* the estimate was used alone at the last update with data */
+  int se_ok;              /* its standard error was small enough at the last update with data (its hysteresis) */
+  int precise_lost;       /* it stopped being used alone: used again once it could have been since precise_since */
+  double precise_since;   /* (NAN: it could not be at the last update) */
+  sticky_flag mismatch, free_beside; /* model_mismatch, the model-free interval beside the model's (alarm.h) */
+  double free_low_kmh, free_high_kmh; /* the last valid model-free interval */
   double v_prev_kmh, t_prev_s, dvdt_kmh_s; /* the speed's trend: an exponential average of dv/dt over ~5 s */
   int have_trend;
-  /* a sustained acceleration (alarm.h): the mean speed of the block being filled and of the last full blocks */
-  double block_sum_kmh, block_sum_t_s, block_t0_s, block_last_s;
+  /* a sustained acceleration (alarm.h): the last speed, the mean of the block being filled and of the full blocks of
+   * the last HM_ALARM_ACCEL_SPAN_S */
+  double v_last_kmh, block_sum_kmh, block_sum_t_s, block_t0_s, block_last_s;
   unsigned block_n, n_blocks;
-  double block_v_kmh[HM_ALARM_ACCEL_BLOCKS + 1], block_t_s[HM_ALARM_ACCEL_BLOCKS + 1]; /* oldest first */
+  double block_v_kmh[HM_ALARM_ACCEL_MAX_BLOCKS], block_t_s[HM_ALARM_ACCEL_MAX_BLOCKS]; /* oldest first */
   /* the last table lookups (at the conicity in use and at the interval's optimistic end), reused while their
    * conicity and the speed are unchanged */
   struct {
@@ -73,6 +88,62 @@ const char *hm_reason_text(hm_reason r) {
     case HM_REASON_NARROW_PEAK: return "a narrow peak at the hunting frequency: a line, or the mode at its Hopf speed";
   }
   return "?";
+}
+
+/* Appends to buf at *n (as snprintf: *n grows by the whole length, buf gets what fits). */
+static void append(char *buf, size_t len, size_t *n, const char *fmt, ...) {
+  va_list ap;
+  va_start(ap, fmt);
+  const int k = vsnprintf(*n < len ? buf + *n : NULL, *n < len ? len - *n : 0, fmt, ap);
+  va_end(ap);
+  if (k > 0) *n += (size_t)k;
+}
+
+/* " at T s" from the origin, or " A s ago" with the origin NAN; nothing for an unknown time. */
+static void append_when(char *buf, size_t len, size_t *n, double t_s, double now_s, double origin_s) {
+  if (!isfinite(t_s)) return;
+  if (isnan(origin_s)) append(buf, len, n, " %.1f s ago", now_s - t_s);
+  else append(buf, len, n, " at %.1f s", t_s - origin_s);
+}
+
+size_t hm_assessment_reason_text(const hm_assessment *s, double origin_s, char *buf, size_t len) {
+  size_t n = 0;
+  if (buf && len) buf[0] = '\0';
+  if (!buf) len = 0;
+  if (!s) return 0;
+  if (!s->latched || !s->held) {
+    append(buf, len, &n, "%s", hm_reason_text(s->reason));
+    return n;
+  }
+  append(buf, len, &n, "held (%s", hm_reason_text(s->hold_cause));
+  append_when(buf, len, &n, s->hold_since_s, s->time_s, origin_s);
+  if (isfinite(s->hold_last_met_s) && s->hold_last_met_s != s->hold_since_s) {
+    append(buf, len, &n, ", last met");
+    append_when(buf, len, &n, s->hold_last_met_s, s->time_s, origin_s);
+  }
+  append(buf, len, &n, "):");
+  if (isfinite(s->hunted_at_kmh)) {
+    append(buf, len, &n, " hunting seen down to %.1f km/h", s->hunted_at_kmh);
+    append_when(buf, len, &n, s->hunted_at_s, s->time_s, origin_s);
+    append(buf, len, &n, ";");
+  }
+  if (isfinite(s->hold_release_below_kmh))
+    append(buf, len, &n, " releases below %.1f km/h after %.0f s calm", s->hold_release_below_kmh, s->calm_needed_s);
+  else
+    append(buf, len, &n, " releases below the Hopf interval after %.0f s calm", s->calm_needed_s);
+  if (s->hold_waits & HM_HOLD_WAITS_DATA) {
+    append(buf, len, &n, " (no current data: the calm is seen only with data)");
+    return n;
+  }
+  append(buf, len, &n, " (calm %.1f s", s->calm_s);
+  if (s->hold_waits & (HM_HOLD_WAITS_SPEED | HM_HOLD_WAITS_OSCILLATION)) append(buf, len, &n, ": waits for");
+  if (s->hold_waits & HM_HOLD_WAITS_SPEED) append(buf, len, &n, " the speed, %.1f km/h", s->speed_kmh);
+  if ((s->hold_waits & HM_HOLD_WAITS_SPEED) && (s->hold_waits & HM_HOLD_WAITS_OSCILLATION)) append(buf, len, &n, ",");
+  if (s->hold_waits & HM_HOLD_WAITS_OSCILLATION)
+    append(buf, len, &n, " the oscillation, %.2f mm (calm below %.2f mm)", 1e3 * s->amplitude_m,
+           1e3 * s->hold_release_amplitude_m);
+  append(buf, len, &n, ")");
+  return n;
 }
 
 void hm_alarm_config_default(hm_alarm_config *c) {
@@ -168,6 +239,7 @@ hm_status hm_alarm_create(const hm_alarm_config *cfg, const hm_vehicle *veh, con
     return st;
   }
   a->table = table;
+  a->precise_since = NAN;
   a->hunted_at_kmh = INFINITY;
   a->memory_s = 900.0;
   a->level = HM_LEVEL_NO_DATA;
@@ -194,7 +266,10 @@ void hm_alarm_restart(hm_alarm a) {
   a->lower_pending = 0;
   a->calm = 0;
   a->hunted_t_s = NAN; /* its age counts again from the next update */
-  a->precise = 0;
+  a->latch_since_s = a->latch_last_met_s = NAN;
+  a->precise = a->precise_lost = a->se_ok = 0;
+  a->precise_since = NAN;
+  a->mismatch.on = a->free_beside.on = 0;
   a->have_trend = 0;
   a->dvdt_kmh_s = 0.0;
   a->block_n = a->n_blocks = 0;
@@ -207,7 +282,12 @@ void hm_alarm_shift_time(hm_alarm a, double delta_s) {
   a->lower_since += delta_s;
   a->calm_since += delta_s;
   a->t_prev_s += delta_s;
+  a->precise_since += delta_s;
+  a->mismatch.false_since_s += delta_s;
+  a->free_beside.false_since_s += delta_s;
   a->hunted_t_s += delta_s;
+  a->latch_since_s += delta_s;
+  a->latch_last_met_s += delta_s;
   a->block_t0_s += delta_s;
   a->block_last_s += delta_s;
   for (unsigned k = 0; k < a->n_blocks; ++k) a->block_t_s[k] += delta_s;
@@ -237,14 +317,19 @@ static int oscillation_reason(hm_reason r) {
          r == HM_REASON_AMPLITUDE_BEYOND_EDGE;
 }
 
-/* The latch's release conditions: no criterion, the oscillation small, the speed below the Hopf interval by the
- * hysteresis (the ALARM level's thresholds are relaxed by it, as everywhere). */
-static int calm_now(const hm_alarm a, const hm_estimate *e, const hm_assessment *s) {
-  const double f = a->cfg.release_amplitude_fraction;
+/* The latch's release conditions (alarm.h) in s: the speed below the Hopf interval by the hysteresis (the ALARM
+ * level's thresholds are relaxed by it, as everywhere), the displacement amplitude below release_amplitude_fraction of
+ * the displacement limit (or of the edge) and no criterion met; what is not met yet goes to s->hold_waits. */
+static void release_conditions(const hm_alarm a, const hm_estimate *e, hm_assessment *s) {
   const double limit = a->displacement_limit_m > 0.0 ? a->displacement_limit_m : s->edge_used_m;
-  const int small = s->amplitude_m < f * (limit > 0.0 ? limit : HM_ESTIMATOR_WHEELSET_DISPLACEMENT_M);
-  return !e->rms_exceeded && !e->peaks_exceeded && !e->displacement_exceeded && small &&
-         e->speed_kmh < s->hopf_low_kmh - a->cfg.hysteresis_kmh;
+  s->hold_release_below_kmh = s->hopf_low_kmh - a->cfg.hysteresis_kmh;
+  s->hold_release_amplitude_m =
+      a->cfg.release_amplitude_fraction * (limit > 0.0 ? limit : HM_ESTIMATOR_WHEELSET_DISPLACEMENT_M);
+  s->hold_waits = 0;
+  if (e->rms_exceeded || e->peaks_exceeded || e->displacement_exceeded ||
+      !(s->amplitude_m < s->hold_release_amplitude_m))
+    s->hold_waits |= HM_HOLD_WAITS_OSCILLATION;
+  if (!(e->speed_kmh < s->hold_release_below_kmh)) s->hold_waits |= HM_HOLD_WAITS_SPEED;
 }
 
 hm_status hm_alarm_set_config(hm_alarm a, const hm_alarm_config *cfg, const hm_vehicle *veh, char *why,
@@ -289,7 +374,7 @@ static hm_level raw_level(const hm_alarm a, const hm_estimate *e, const hm_margi
   if (v_ahead >= s->warn_from_kmh - hv_warn) return *reason = HM_REASON_NEAR_HOPF, HM_LEVEL_WARN;
   if (v_ahead >= s->watch_from_kmh - hv_watch)
     return *reason = HM_REASON_APPROACHING_HOPF, HM_LEVEL_WATCH;
-  if (g && g->model_mismatch) return *reason = HM_REASON_MODEL_MISMATCH, HM_LEVEL_WATCH;
+  if (s->model_mismatch) return *reason = HM_REASON_MODEL_MISMATCH, HM_LEVEL_WATCH;
   if (g && g->conicity_valid && g->outside_prior && c->use_conicity_estimate)
     return *reason = HM_REASON_OUTSIDE_PRIOR, HM_LEVEL_WATCH;
   if (s->narrow_peak_ambiguous) return *reason = HM_REASON_NARROW_PEAK, HM_LEVEL_WATCH;
@@ -299,17 +384,19 @@ static hm_level raw_level(const hm_alarm a, const hm_estimate *e, const hm_margi
   return *reason = HM_REASON_NORMAL, HM_LEVEL_OK;
 }
 
-/* The table's boundaries at (conicity, speed) through cache slot k; the Hopf speed is the closed form's where the
- * conicity lies outside the table (a clamped lookup's would belong to another conicity). */
+/* The table's boundaries at (conicity, speed) through cache slot k. Outside the table's conicities the widened
+ * lookup (tables.h: the cautious of the end conicity's and the extrapolated, not the end's alone; alarm.h); where the
+ * extrapolation has no Hopf speed, the clamped lookup with the closed-form Hopf speed. */
 static hm_status lookup(hm_alarm a, int k, double conicity, double speed_kmh, hm_table_lookup_result *out) {
   if (a->cache[k].valid && a->cache[k].conicity == conicity && a->cache[k].speed_kmh == speed_kmh) {
     *out = a->cache[k].r;
     return HM_OK;
   }
   hm_table_lookup_result r;
-  const hm_status st = hm_table_lookup(a->table, conicity, speed_kmh, &r);
+  hm_status st = hm_table_lookup_widened(a->table, conicity, speed_kmh, &r);
+  if (st == HM_EDOMAIN && isfinite(conicity) && isfinite(speed_kmh)) st = hm_table_lookup(a->table, conicity, speed_kmh, &r);
   if (st != HM_OK) return st;
-  if (r.conicity != conicity) r.hopf_speed_kmh = hm_linear_hopf_kmh(&a->veh, conicity);
+  if (r.conicity != conicity && !r.widened) r.hopf_speed_kmh = hm_linear_hopf_kmh(&a->veh, conicity);
   a->cache[k].valid = 1;
   a->cache[k].conicity = conicity;
   a->cache[k].speed_kmh = speed_kmh;
@@ -318,11 +405,11 @@ static hm_status lookup(hm_alarm a, int k, double conicity, double speed_kmh, hm
   return HM_OK;
 }
 
-/* The block being filled joins the last ones (the oldest dropped beyond HM_ALARM_ACCEL_BLOCKS + 1). */
+/* The block being filled joins the full ones (the oldest dropped when the ring is full). */
 static void close_block(hm_alarm a) {
-  if (a->n_blocks == HM_ALARM_ACCEL_BLOCKS + 1) {
-    memmove(a->block_v_kmh, a->block_v_kmh + 1, HM_ALARM_ACCEL_BLOCKS * sizeof(double));
-    memmove(a->block_t_s, a->block_t_s + 1, HM_ALARM_ACCEL_BLOCKS * sizeof(double));
+  if (a->n_blocks == HM_ALARM_ACCEL_MAX_BLOCKS) {
+    memmove(a->block_v_kmh, a->block_v_kmh + 1, (HM_ALARM_ACCEL_MAX_BLOCKS - 1) * sizeof(double));
+    memmove(a->block_t_s, a->block_t_s + 1, (HM_ALARM_ACCEL_MAX_BLOCKS - 1) * sizeof(double));
     --a->n_blocks;
   }
   a->block_v_kmh[a->n_blocks] = a->block_sum_kmh / a->block_n;
@@ -331,29 +418,72 @@ static void close_block(hm_alarm a) {
   a->block_n = 0;
 }
 
-/* The speed into the block being filled; a full block (HM_ALARM_ACCEL_BLOCK_S) joins the last ones. The sustained
- * acceleration [km/h/s]: the least of the slopes between consecutive block means over the last
- * HM_ALARM_ACCEL_BLOCKS of them, 0 unless all are positive, at most HM_ALARM_MAX_ACCEL_KMH_S (alarm.h). Updates
- * further apart than a block give a block each (the one in progress is closed first); a time step back or a silence
- * as long as the blocks' whole span starts again. */
+/* The least-squares slope of the full blocks' mean speeds on their mean times [km/h/s]; 0 for fewer than two. */
+static double blocks_slope(const hm_alarm a) {
+  double st = 0.0, sv = 0.0;
+  for (unsigned k = 0; k < a->n_blocks; ++k) st += a->block_t_s[k], sv += a->block_v_kmh[k];
+  const double n = (double)a->n_blocks, tm = st / n, vm = sv / n;
+  double stt = 0.0, stv = 0.0;
+  for (unsigned k = 0; k < a->n_blocks; ++k) {
+    const double dt = a->block_t_s[k] - tm;
+    stt += dt * dt;
+    stv += dt * (a->block_v_kmh[k] - vm);
+  }
+  return a->n_blocks >= 2 && stt > 0.0 ? stv / stt : 0.0;
+}
+
+/* The sustained acceleration [km/h/s] (alarm.h): the speed goes into blocks of HM_ALARM_ACCEL_BLOCK_S (updates
+ * further apart than a block give a block each), and the least-squares slope of the mean speeds of the full blocks of
+ * the last HM_ALARM_ACCEL_SPAN_S, once they span HM_ALARM_ACCEL_MIN_SPAN_S, is the acceleration, clamped to [0,
+ * HM_ALARM_MAX_ACCEL_KMH_S]. A step of the signal (a change between updates beyond HM_ALARM_STEP_RATE_KMH_S times their
+ * interval plus HM_ALARM_STEP_NOISE_KMH), a time step back or a silence of HM_ALARM_ACCEL_SILENCE_S starts again (a
+ * step taken out by its own increment would leave two samples' noise as a level shift: 1.3 km/h of anticipation). */
 static double sustained_acceleration(hm_alarm a, double now, double v_kmh) {
-  const double block_s = HM_ALARM_ACCEL_BLOCK_S;
   if (a->block_n + a->n_blocks > 0 &&
-      (now < a->block_last_s || now - a->block_last_s > HM_ALARM_ACCEL_BLOCKS * block_s))
+      (now < a->block_last_s || now - a->block_last_s > HM_ALARM_ACCEL_SILENCE_S ||
+       fabs(v_kmh - a->v_last_kmh) > HM_ALARM_STEP_RATE_KMH_S * (now - a->block_last_s) + HM_ALARM_STEP_NOISE_KMH))
     a->block_n = a->n_blocks = 0;
-  if (a->block_n > 0 && now - a->block_t0_s >= block_s) close_block(a);
+  a->v_last_kmh = v_kmh;
+  if (a->block_n > 0 && now - a->block_t0_s >= HM_ALARM_ACCEL_BLOCK_S) close_block(a);
   a->block_last_s = now;
   if (a->block_n == 0) a->block_t0_s = now, a->block_sum_kmh = a->block_sum_t_s = 0.0;
   a->block_sum_kmh += v_kmh;
   a->block_sum_t_s += now - a->block_t0_s;
   ++a->block_n;
-  if (a->n_blocks < HM_ALARM_ACCEL_BLOCKS + 1) return 0.0;
-  double least = HM_ALARM_MAX_ACCEL_KMH_S;
-  for (unsigned k = 0; k < HM_ALARM_ACCEL_BLOCKS; ++k) {
-    const double dt = a->block_t_s[k + 1] - a->block_t_s[k];
-    least = fmin(least, dt > 0.0 ? (a->block_v_kmh[k + 1] - a->block_v_kmh[k]) / dt : 0.0);
+  unsigned old = 0; /* full blocks older than the span */
+  while (old < a->n_blocks && a->block_t_s[old] < now - HM_ALARM_ACCEL_SPAN_S) ++old;
+  if (old > 0) {
+    memmove(a->block_v_kmh, a->block_v_kmh + old, (a->n_blocks - old) * sizeof(double));
+    memmove(a->block_t_s, a->block_t_s + old, (a->n_blocks - old) * sizeof(double));
+    a->n_blocks -= old;
   }
-  return fmax(least, 0.0);
+  if (a->n_blocks < 2 || a->block_t_s[a->n_blocks - 1] - a->block_t_s[0] < HM_ALARM_ACCEL_MIN_SPAN_S) return 0.0;
+  return fmin(fmax(blocks_slope(a), 0.0), HM_ALARM_MAX_ACCEL_KMH_S);
+}
+
+static int sticky(sticky_flag *f, int condition, double now) {
+  if (condition) {
+    f->on = 1;
+    f->false_since_s = NAN;
+  } else if (f->on) {
+    if (isnan(f->false_since_s)) f->false_since_s = now;
+    if (now - f->false_since_s >= HM_ALARM_FLAG_CLEAR_S) f->on = 0;
+  }
+  return f->on;
+}
+
+/* The estimate's use alone (alarm.h): at once the first time, at once dropped, and once dropped taken again only after
+ * its condition has held for HM_ALARM_FLAG_CLEAR_S. */
+static int regained(hm_alarm a, int condition, double now) {
+  if (!condition) {
+    if (a->precise) a->precise_lost = 1;
+    a->precise_since = NAN;
+    return 0;
+  }
+  if (isnan(a->precise_since)) a->precise_since = now;
+  if (a->precise_lost && now - a->precise_since < HM_ALARM_FLAG_CLEAR_S) return 0;
+  a->precise_lost = 0;
+  return 1;
 }
 
 /* WARN from an identified Hopf speed (alarm.h): the point less the larger of the margin and one standard error, the
@@ -365,18 +495,26 @@ static double warn_below_point(double point_kmh, double low_kmh, double margin_k
 /* The conicity in use, the Hopf interval and the boundaries at the current speed; the table's status on failure. */
 static hm_status assess(hm_alarm a, const hm_estimate *e, const hm_margin_estimate *g, hm_assessment *s) {
   const hm_alarm_config *c = &a->cfg;
+  const double now = s->time_s;
   const int axle = a->point == HM_POINT_WHEELSET;
   const int have = c->use_conicity_estimate && g && g->conicity_valid && g->hopf_model_valid;
+  /* the margin's flags as the level uses them, held against the provisional window's chatter (alarm.h) */
+  const int mismatch = sticky(&a->mismatch, g && g->model_mismatch, now);
   /* the model-based interval counts from an axle-box sensor on a vehicle that behaves like its model (alarm.h) */
-  const int usable_model = have && axle && !g->model_mismatch;
-  const double max_se = a->precise ? HM_ALARM_SE_HYSTERESIS * c->conicity_max_se : c->conicity_max_se;
+  const int usable_model = have && axle && !mismatch;
+  /* the standard error within conicity_max_se, once so within HM_ALARM_SE_HYSTERESIS times it (its own hysteresis,
+   * whatever else keeps the estimate from being used alone) */
+  const double max_se = a->se_ok ? HM_ALARM_SE_HYSTERESIS * c->conicity_max_se : c->conicity_max_se;
+  a->se_ok = usable_model && g->conicity_se <= max_se;
   const int unconfirmed_change = g && g->n_changes > 0 && g->windows_since_change < 2;
-  /* an estimate enters alone when precise, inside the prior and not a change's first window; otherwise combined with
-   * the prior (the more cautious): one precise but above the prior's range (its Hopf speed lower: worn beyond the
-   * prior), or any with a lightly damped mode held (alarm.h) */
-  const int precise = usable_model && g->conicity_se <= max_se && !g->outside_prior && !unconfirmed_change;
-  const int cautious_precise = usable_model && g->conicity_se <= max_se && g->outside_prior > 0;
-  const int usable = precise || cautious_precise || (usable_model && g->near_evidence);
+  /* an estimate enters alone when precise, inside the prior and not a change's first window (once it stopped being
+   * so, only after it has been so again for HM_ALARM_FLAG_CLEAR_S, meanwhile combined with the prior); otherwise
+   * combined with the prior (the more cautious): one precise but above the prior's range (its Hopf speed lower: worn
+   * beyond the prior), or any with a lightly damped mode held (alarm.h) */
+  const int alone = a->se_ok && !g->outside_prior && !unconfirmed_change;
+  const int precise = regained(a, alone, now);
+  const int cautious_precise = a->se_ok && g->outside_prior > 0;
+  const int usable = precise || alone || cautious_precise || (usable_model && g->near_evidence);
   /* the prior's interval, and the uncertain estimate's where it is the more cautious */
   double lambda = c->conicity_fallback, lambda_opt = c->conicity_prior_low;
   double lo = a->prior_hopf_low_kmh, hi = a->prior_hopf_high_kmh;
@@ -401,17 +539,23 @@ static hm_status assess(hm_alarm a, const hm_estimate *e, const hm_margin_estima
    * regression has residuals to check it (three windows or more) and a lightly damped mode is held: a zero crossing
    * extrapolated from decay rates of -5..-11 1/s alone is wide (on a ramp from 271 to 301 km/h, 322 [309, ...] for a
    * Hopf speed of 357) and its lower end is no evidence */
-  const int free_alone = g && (g->model_mismatch || !axle);
-  const int free_counts =
-      g && g->hopf_free_valid && (free_alone || (g->n_windows >= HM_ALARM_FREE_MIN_WINDOWS && g->near_evidence));
+  const int free_alone = g && (mismatch || !axle);
+  const int free_valid = g && g->hopf_free_valid;
+  if (free_valid) a->free_low_kmh = g->hopf_free_low_kmh, a->free_high_kmh = g->hopf_free_high_kmh;
+  const int free_beside = sticky(
+      &a->free_beside, free_valid && g->n_windows >= HM_ALARM_FREE_MIN_WINDOWS && g->near_evidence && !free_alone, now);
+  const int free_counts = (free_valid && free_alone) || free_beside; /* (held: its last valid interval) */
+  s->model_mismatch = mismatch;
+  s->hopf_free_used = free_counts;
   if (free_counts) {
-    lo = fmin(lo, g->hopf_free_low_kmh);
-    if (free_alone && g->hopf_free_high_kmh < hi) hi = g->hopf_free_high_kmh;
+    lo = fmin(lo, a->free_low_kmh);
+    if (free_alone && a->free_high_kmh < hi) hi = a->free_high_kmh;
   }
   s->conicity = lambda;
   hm_table_lookup_result b, bo;
   hm_status st = lookup(a, 0, lambda, e->speed_kmh, &b);
   if (st != HM_OK) return st;
+  s->conicity_outside_table = b.conicity == lambda ? 0 : lambda > b.conicity ? 1 : -1;
   if (!precise) { /* the table's value at the point is inside the interval it is shown with */
     lo = fmin(lo, b.hopf_speed_kmh - b.error_speed_kmh);
     hi = fmax(hi, b.hopf_speed_kmh + b.error_speed_kmh);
@@ -428,7 +572,7 @@ static hm_status assess(hm_alarm a, const hm_estimate *e, const hm_margin_estima
   const double z = g && g->interval_z > 0.0 ? g->interval_z : 1.0;
   s->warn_from_kmh = warn_below_point(from, precise ? s->hopf_low_kmh : from, c->warn_speed_margin_kmh, z);
   if (usable && !precise) {
-    const double lo_e = free_counts ? fmin(g->hopf_model_low_kmh, g->hopf_free_low_kmh) : g->hopf_model_low_kmh;
+    const double lo_e = free_counts ? fmin(g->hopf_model_low_kmh, a->free_low_kmh) : g->hopf_model_low_kmh;
     s->warn_from_kmh = fmin(a->prior_hopf_low_kmh - c->warn_speed_margin_kmh,
                             warn_below_point(g->hopf_model_kmh, lo_e, c->warn_speed_margin_kmh, z));
   }
@@ -449,10 +593,19 @@ static hm_status assess(hm_alarm a, const hm_estimate *e, const hm_margin_estima
   return HM_OK;
 }
 
+/* WARN and WATCH from at most basis_kmh less their margins (the published fields agree, alarm.h); warn_risk is not
+ * stated for a WARN speed the interval did not set. */
+static void below(const hm_alarm a, hm_assessment *s, double basis_kmh) {
+  const double warn_from = basis_kmh - a->cfg.warn_speed_margin_kmh;
+  if (warn_from < s->warn_from_kmh) s->warn_from_kmh = warn_from, s->warn_risk = NAN;
+  s->watch_from_kmh = fmin(s->watch_from_kmh, basis_kmh - a->cfg.watch_speed_margin_kmh);
+}
+
 /* Hunting met a criterion at a speed below the interval: the vehicle's Hopf speed (or, after a large disturbance, its
  * lowest cycle speed) may be no higher. The lowest such speed of the latch bounds the interval's lower end, and the
- * WARN and WATCH thresholds below it by their margins, while the ALARM is held and for memory_s after it (alarm.h);
- * the latch is released only below it. */
+ * WARN and WATCH thresholds below it by their margins (also where it lies inside the interval), while the ALARM is
+ * held and for memory_s after it (alarm.h); the latch is released only below it. While held, WARN and WATCH lie below
+ * the interval's lower end by their margins. */
 static void hunted_bound(hm_alarm a, const hm_estimate *e, double now, hm_assessment *s) {
   if (e->rms_exceeded || e->peaks_exceeded || e->displacement_exceeded) {
     if (!a->latched && a->hunted_at_kmh < INFINITY && !(now - a->hunted_t_s <= a->memory_s))
@@ -462,11 +615,57 @@ static void hunted_bound(hm_alarm a, const hm_estimate *e, double now, hm_assess
   if (isnan(a->hunted_t_s) && a->hunted_at_kmh < INFINITY) a->hunted_t_s = now; /* a restarted time line */
   if (!a->latched && !(now - a->hunted_t_s <= a->memory_s)) a->hunted_at_kmh = INFINITY;
   s->hunted_at_kmh = a->hunted_at_kmh < INFINITY ? a->hunted_at_kmh : NAN;
-  if (!(a->hunted_at_kmh < s->hopf_low_kmh)) return;
-  s->hopf_low_kmh = a->hunted_at_kmh;
-  s->hopf_low_from_hunting = 1;
-  s->warn_from_kmh = fmin(s->warn_from_kmh, a->hunted_at_kmh - a->cfg.warn_speed_margin_kmh);
-  s->watch_from_kmh = fmin(s->watch_from_kmh, a->hunted_at_kmh - a->cfg.watch_speed_margin_kmh);
+  s->hunted_at_s = a->hunted_at_kmh < INFINITY ? a->hunted_t_s : NAN;
+  if (a->hunted_at_kmh < INFINITY) { /* the thresholds below it by their margins, also inside the interval */
+    below(a, s, a->hunted_at_kmh);
+    if (a->hunted_at_kmh < s->hopf_low_kmh) {
+      s->hopf_low_kmh = a->hunted_at_kmh;
+      s->hopf_low_from_hunting = 1;
+      s->warn_risk = NAN; /* the interval read as normal is not what the level uses */
+    }
+  }
+  if (a->latched) below(a, s, s->hopf_low_kmh); /* during a hold from the held interval's lower end */
+}
+
+/* The latch (alarm.h) with data: an oscillation ALARM latches (its first cause and time kept); a latched one holds,
+ * with that cause, until the release conditions have held for release_s. */
+static void latch(hm_alarm a, const hm_estimate *e, double now, hm_assessment *s, hm_level *target, hm_reason *reason) {
+  const int oscillation = *target == HM_LEVEL_ALARM && oscillation_reason(*reason);
+  if (a->latched || oscillation) release_conditions(a, e, s);
+  if (oscillation) {
+    if (!a->latched) a->latch_cause = *reason, a->latch_since_s = now;
+    a->latched = 1;
+    a->latch_last_met_s = now;
+    a->calm = 0;
+  } else if (a->latched) {
+    if (s->hold_waits) a->calm = 0;
+    else if (!a->calm) a->calm = 1, a->calm_since = now;
+    if (a->calm && now - a->calm_since >= a->cfg.release_s) {
+      a->latched = 0; /* the hunted-at speed stays a bound for memory_s */
+    } else {
+      *target = HM_LEVEL_ALARM;
+      *reason = a->latch_cause;
+      s->held = 1;
+      if (a->calm) s->hold_waits = HM_HOLD_WAITS_TIME;
+    }
+  }
+  s->latched = a->latched;
+}
+
+/* The hold in numbers (alarm.h): while latched its cause, times, calm so far and needed; else none. */
+static void hold_numbers(const hm_alarm a, double now, hm_assessment *s) {
+  if (a->latched) {
+    s->hold_cause = a->latch_cause;
+    s->hold_since_s = a->latch_since_s;
+    s->hold_last_met_s = a->latch_last_met_s;
+    s->calm_needed_s = a->cfg.release_s;
+    s->calm_s = s->held && a->calm ? now - a->calm_since : 0.0;
+    s->release_in_s = s->calm_needed_s - s->calm_s;
+  } else {
+    s->hold_cause = HM_REASON_STARTUP;
+    s->hold_since_s = s->hold_last_met_s = s->hold_release_below_kmh = s->hold_release_amplitude_m = NAN;
+    s->hold_waits = 0;
+  }
 }
 
 hm_status hm_alarm_update(hm_alarm a, const hm_estimate *e, const hm_margin_estimate *g, double now, hm_assessment *out) {
@@ -474,6 +673,9 @@ hm_status hm_alarm_update(hm_alarm a, const hm_estimate *e, const hm_margin_esti
   const hm_alarm_config *c = &a->cfg;
   hm_assessment s;
   memset(&s, 0, sizeof s);
+  s.time_s = now;
+  s.speed_kmh = e->speed_valid ? e->speed_kmh : 0.0;
+  s.hunted_at_kmh = s.hunted_at_s = NAN;
   hm_reason reason;
   hm_level target;
   if (!e->accel_valid || !e->speed_valid) {
@@ -484,10 +686,11 @@ hm_status hm_alarm_update(hm_alarm a, const hm_estimate *e, const hm_margin_esti
     a->block_n = a->n_blocks = 0; /* no speed: the acceleration starts again */
     if (a->latched) { /* a held ALARM outlives its data: nothing says the oscillation has gone (alarm.h) */
       target = HM_LEVEL_ALARM;
-      reason = a->latch_reason;
+      reason = a->latch_cause;
       a->calm = 0;
-      s.latched = 1;
-      s.release_in_s = c->release_s;
+      s.latched = s.held = 1;
+      s.hold_release_below_kmh = s.hold_release_amplitude_m = NAN; /* no current boundaries */
+      s.hold_waits = HM_HOLD_WAITS_DATA;
     }
   } else {
     const hm_status st = assess(a, e, g, &s);
@@ -519,25 +722,9 @@ hm_status hm_alarm_update(hm_alarm a, const hm_estimate *e, const hm_margin_esti
       hm_reason r_ahead;
       if (raw_level(a, &ahead, g, &s, a->level, &r_ahead) >= a->level) target = a->level, reason = a->reason;
     }
-    if (target == HM_LEVEL_ALARM && oscillation_reason(reason)) {
-      a->latched = 1;
-      a->latch_reason = reason;
-      a->calm = 0;
-    } else if (a->latched) {
-      /* held until calm for release_s */
-      const int calm = calm_now(a, e, &s);
-      if (!calm) a->calm = 0;
-      else if (!a->calm) a->calm = 1, a->calm_since = now;
-      if (a->calm && now - a->calm_since >= c->release_s) {
-        a->latched = 0; /* the hunted-at speed stays a bound for memory_s */
-      } else {
-        target = HM_LEVEL_ALARM;
-        reason = a->latch_reason;
-        s.release_in_s = a->calm ? c->release_s - (now - a->calm_since) : c->release_s;
-      }
-    }
-    s.latched = a->latched;
+    latch(a, e, now, &s, &target, &reason);
   }
+  hold_numbers(a, now, &s);
   /* (with no data the latch is kept: nothing says the oscillation has gone) */
   s.changed = 0;
   if (target >= a->level || target == HM_LEVEL_NO_DATA || a->level == HM_LEVEL_NO_DATA) {

@@ -64,8 +64,8 @@ hm_status hm_sensor_sim_create(const hm_vehicle *veh, const hm_sensor_sim_config
     return refuse(why, why_len, HM_EDOMAIN, "speeds must be finite and > 0 km/h");
   if (!(c->ramp_s >= 0.0) || !isfinite(c->ramp_s)) return refuse(why, why_len, HM_EDOMAIN, "ramp_s must be >= 0");
   if (c->n_profile && !hm_speed_profile_valid(c->profile_t_s, c->profile_v_kmh, c->n_profile))
-    return refuse(why, why_len, HM_EDOMAIN,
-                  "the speed profile needs at most 16 points, speeds > 0 km/h at times increasing from 0 s");
+    return refuse(why, why_len, HM_EDOMAIN, "the speed profile needs at most %d points, speeds > 0 km/h at times "
+                  "increasing from 0 s", HM_SPEED_PROFILE_MAX);
   if (!(c->irregularity_scale >= 0.0) || !isfinite(c->irregularity_scale))
     return refuse(why, why_len, HM_EDOMAIN, "irregularity scale must be >= 0");
   if (!(c->wavelength_min_m >= 0.2) || !(c->wavelength_max_m > c->wavelength_min_m) || !(c->wavelength_max_m <= 1000.0))

@@ -93,31 +93,24 @@ static size_t interval_of(const hm_table t, double c) {
   return lo;
 }
 
-hm_status hm_table_lookup(const hm_table t, double conicity, double speed_kmh, hm_table_lookup_result *out) {
-  if (!t || !out || t->n < 2) return HM_EINVAL;
-  if (!isfinite(conicity) || !isfinite(speed_kmh)) return HM_EDOMAIN;
-  hm_table_lookup_result r;
-  memset(&r, 0, sizeof r);
-  double c = conicity, v = speed_kmh;
-  const double cmin = t->curves[0].conicity, cmax = t->curves[t->n - 1].conicity;
-  if (c < cmin || c > cmax) {
-    c = fmin(fmax(c, cmin), cmax);
-    r.clamped = 1;
-  }
-  if (v < t->speed_min_kmh || v > t->speed_max_kmh) {
-    v = fmin(fmax(v, t->speed_min_kmh), t->speed_max_kmh);
-    r.clamped = 1;
-  }
-  const size_t i = interval_of(t, c); /* bracketing curves i, i+1 */
+/* The Hopf speed at weight w along the interval [curves[i], curves[i+1]] (w outside [0, 1] extrapolates: exact, as
+ * 1/V_hopf^2 is affine in lambda(0), linear.h); 0 where the extrapolation leaves no Hopf speed. */
+static double hopf_at(const hm_table t, size_t i, double w) {
   const tcurve *a = &t->curves[i], *b = &t->curves[i + 1];
-  const double w = (c - a->conicity) / (b->conicity - a->conicity);
-  r.conicity = c;
-  /* 1/V_hopf^2 is exactly linear in lambda(0) (linear.h: D is affine in lambda), so interpolate that; the
-   * other speeds scale with the Hopf speed (Klingel: V ~ 1/sqrt(lambda)), so interpolate their ratios to it
-   * and compare the neighbours' cycle families at the same fraction of their own Hopf speed. */
   const double inv2 = 1.0 / (a->hopf_kmh * a->hopf_kmh) + w * (1.0 / (b->hopf_kmh * b->hopf_kmh) -
                                                                1.0 / (a->hopf_kmh * a->hopf_kmh));
-  r.hopf_speed_kmh = 1.0 / sqrt(inv2);
+  return inv2 > 0.0 ? 1.0 / sqrt(inv2) : 0.0;
+}
+
+/* The boundaries at speed v of a conicity whose Hopf speed is hopf_kmh, from the interval [curves[i], curves[i+1]] at
+ * weight w: the other speeds scale with the Hopf speed (Klingel: V ~ 1/sqrt(lambda)), so their ratios to it are
+ * interpolated and the neighbours' cycle families compared at the same fraction of their own Hopf speed. */
+static void lookup_at(const hm_table t, size_t i, double w, double hopf_kmh, double v, double speed_kmh,
+                      hm_table_lookup_result *out) {
+  const tcurve *a = &t->curves[i], *b = &t->curves[i + 1];
+  hm_table_lookup_result r;
+  memset(&r, 0, sizeof r);
+  r.hopf_speed_kmh = hopf_kmh;
   r.l1 = a->l1 + w * (b->l1 - a->l1);
   const double ra = a->lowest_kmh / a->hopf_kmh, rb = b->lowest_kmh / b->hopf_kmh;
   r.lowest_cycle_speed_kmh = (ra + w * (rb - ra)) * r.hopf_speed_kmh;
@@ -144,6 +137,76 @@ hm_status hm_table_lookup(const hm_table t, double conicity, double speed_kmh, h
   r.error_speed_kmh = fmax(t->err_hopf_kmh, t->err_lowest_kmh);
   r.error_amp_m = t->err_amp_m;
   *out = r;
+}
+
+hm_status hm_table_lookup(const hm_table t, double conicity, double speed_kmh, hm_table_lookup_result *out) {
+  if (!t || !out || t->n < 2) return HM_EINVAL;
+  if (!isfinite(conicity) || !isfinite(speed_kmh)) return HM_EDOMAIN;
+  double c = conicity, v = speed_kmh;
+  int clamped = 0;
+  const double cmin = t->curves[0].conicity, cmax = t->curves[t->n - 1].conicity;
+  if (c < cmin || c > cmax) {
+    c = fmin(fmax(c, cmin), cmax);
+    clamped = 1;
+  }
+  if (v < t->speed_min_kmh || v > t->speed_max_kmh) {
+    v = fmin(fmax(v, t->speed_min_kmh), t->speed_max_kmh);
+    clamped = 1;
+  }
+  const size_t i = interval_of(t, c); /* bracketing curves i, i+1 */
+  const double w = (c - t->curves[i].conicity) / (t->curves[i + 1].conicity - t->curves[i].conicity);
+  lookup_at(t, i, w, hopf_at(t, i, w), v, speed_kmh, out);
+  out->conicity = c;
+  out->clamped = clamped;
+  return HM_OK;
+}
+
+/* The more cautious of two readings of the amplitude of a cycle that bounds the stable origin's basin (the smaller) or
+ * of one that hunting may reach (the larger; toward: -1 or +1), less their difference as its error. */
+static double cautious(double x, double y, double toward) {
+  return toward < 0.0 ? fmin(x, y) - fabs(x - y) : fmax(x, y) + fabs(x - y);
+}
+
+hm_status hm_table_lookup_widened(const hm_table t, double conicity, double speed_kmh, hm_table_lookup_result *out) {
+  if (!t || !out || t->n < 2) return HM_EINVAL;
+  if (!isfinite(conicity) || !isfinite(speed_kmh)) return HM_EDOMAIN;
+  const double cmin = t->curves[0].conicity, cmax = t->curves[t->n - 1].conicity;
+  if (conicity >= cmin && conicity <= cmax) return hm_table_lookup(t, conicity, speed_kmh, out);
+  const double v = fmin(fmax(speed_kmh, t->speed_min_kmh), t->speed_max_kmh);
+  const size_t i = conicity < cmin ? 0 : t->n - 2; /* the end interval */
+  const double w_end = conicity < cmin ? 0.0 : 1.0;
+  const double w = (conicity - t->curves[i].conicity) / (t->curves[i + 1].conicity - t->curves[i].conicity);
+  const double hopf = hopf_at(t, i, w);
+  if (!(hopf > 0.0)) return HM_EDOMAIN;
+  /* (a) the end conicity's boundaries at this speed; (b) its family at this conicity's fraction of the Hopf speed;
+   * (c) the end interval extrapolated */
+  hm_table_lookup_result ra, rb, rc;
+  lookup_at(t, i, w_end, hopf_at(t, i, w_end), v, speed_kmh, &ra);
+  lookup_at(t, i, w_end, hopf, v, speed_kmh, &rb);
+  lookup_at(t, i, w, hopf, v, speed_kmh, &rc);
+  hm_table_lookup_result r = rc;
+  r.conicity = t->curves[i + (size_t)w_end].conicity;
+  r.clamped = r.widened = 1;
+  r.l1 = ra.l1;
+  r.lowest_cycle_speed_kmh = fmax(0.0, fmin(ra.lowest_cycle_speed_kmh, cautious(rb.lowest_cycle_speed_kmh,
+                                                                                rc.lowest_cycle_speed_kmh, -1.0)));
+  /* (the end conicity's edge only where its own origin is stable: beyond its Hopf speed it has none to give) */
+  const int a_edge = ra.has_edge && ra.origin_stable;
+  r.has_edge = a_edge || rb.has_edge || rc.has_edge;
+  if (r.has_edge && r.origin_stable) {
+    double e = INFINITY;
+    if (a_edge) e = fmin(e, ra.edge_amp_m);
+    if (rb.has_edge && rc.has_edge) e = fmin(e, cautious(rb.edge_amp_m, rc.edge_amp_m, -1.0));
+    else if (rb.has_edge || rc.has_edge) e = fmin(e, rb.has_edge ? rb.edge_amp_m : rc.edge_amp_m);
+    r.edge_amp_m = fmax(e, 0.0);
+  }
+  r.has_stable_outer = ra.has_stable_outer && rb.has_stable_outer && rc.has_stable_outer;
+  if (r.has_stable_outer)
+    r.stable_outer_amp_m = fmax(ra.stable_outer_amp_m, cautious(rb.stable_outer_amp_m, rc.stable_outer_amp_m, 1.0));
+  r.consistent = ra.consistent && rb.consistent && rc.consistent && ra.has_edge == rc.has_edge &&
+                 ra.has_stable_outer == rc.has_stable_outer;
+  r.neighbour_spread_m = fmax(fmax(ra.neighbour_spread_m, rc.neighbour_spread_m), fabs(rb.edge_amp_m - rc.edge_amp_m));
+  *out = r; /* (the stated errors the table's: the Hopf speed is exact, the rest already widened) */
   return HM_OK;
 }
 

@@ -23,6 +23,12 @@ namespace {
 constexpr double kLossWarnFraction = 0.01;
 // A NaN never goes out: unknown quantities are 0 with their *_valid flag false.
 double finite(double x) { return std::isfinite(x) ? x : 0.0; }
+// The status's reason in words (the core's: while held, its cause, ages and the release condition).
+std::string reasonText(const hm_assessment& s) {
+  char text[512];
+  hm_assessment_reason_text(&s, NAN, text, sizeof text);  // times as ages: the sensor's line is no clock to read
+  return text;
+}
 }  // namespace
 
 // The diagnostics are named after the private namespace: the node's name, or the nodelet's (not its manager's).
@@ -313,11 +319,22 @@ void MonitorRos::onTimer(const ros::TimerEvent&) {
   m.sensor_clock_steps = static_cast<uint32_t>(clock_.n_steps);
   m.level = static_cast<uint8_t>(s.level);
   m.reason_code = static_cast<uint8_t>(s.reason);
-  m.reason = hm_reason_text(s.reason);
+  m.reason = reasonText(s);
   m.level_latched = s.latched;
   m.latch_release_in_s = s.latched ? finite(s.release_in_s) : 0.0;
+  m.level_held = s.held;
+  m.hold_cause_code = static_cast<uint8_t>(s.hold_cause);
+  m.hold_cause = s.latched ? hm_reason_text(s.hold_cause) : "";
+  if (std::isfinite(s.hold_since_s)) m.hold_since = ros::Time(rosTime(s.hold_since_s));
+  if (std::isfinite(s.hold_last_met_s)) m.hold_last_met = ros::Time(rosTime(s.hold_last_met_s));
+  m.hold_release_below_kmh = finite(s.hold_release_below_kmh);
+  m.hold_release_amplitude_m = finite(s.hold_release_amplitude_m);
+  m.hold_calm_s = finite(s.calm_s);
+  m.hold_calm_needed_s = finite(s.calm_needed_s);
+  m.hold_waits = static_cast<uint8_t>(s.hold_waits);
   m.hopf_low_from_hunting = s.boundaries_valid && s.hopf_low_from_hunting;
   m.hunted_at_kmh = s.boundaries_valid && std::isfinite(s.hunted_at_kmh) ? s.hunted_at_kmh : 0.0;
+  if (s.boundaries_valid && std::isfinite(s.hunted_at_s)) m.hunted_at = ros::Time(rosTime(s.hunted_at_s));
   m.speed_kmh = finite(e.speed_kmh);
   m.speed_valid = e.speed_valid;
   m.sample_rate_hz = finite(e.sample_rate_measured_hz);
@@ -366,7 +383,8 @@ void MonitorRos::onTimer(const ros::TimerEvent&) {
   m.hopf_free_kmh = g.hopf_free_valid ? finite(g.hopf_free_kmh) : 0.0;
   m.hopf_free_kmh_low = g.hopf_free_valid ? finite(g.hopf_free_low_kmh) : 0.0;
   m.hopf_free_kmh_high = g.hopf_free_valid ? finite(g.hopf_free_high_kmh) : 0.0;
-  m.model_mismatch = g.model_mismatch;
+  m.model_mismatch = s.boundaries_valid ? s.model_mismatch : g.model_mismatch;  // as the level uses it (held)
+  m.model_mismatch_windows = g.model_mismatch;
   m.windows_birge_ratio = finite(g.birge_ratio);
   m.misfit_windows = g.n_misfits;
   m.conicity_changes = static_cast<uint32_t>(g.n_changes);
@@ -386,6 +404,8 @@ void MonitorRos::onTimer(const ros::TimerEvent&) {
   m.conicity_from_estimate = s.boundaries_valid && s.conicity_from_estimate;
   m.conicity_from_prior = s.boundaries_valid && s.conicity_from_prior;
   m.model_interval_used = s.boundaries_valid && s.model_interval_used;
+  m.hopf_free_used = s.boundaries_valid && s.hopf_free_used;
+  m.conicity_outside_table = static_cast<int8_t>(s.boundaries_valid ? s.conicity_outside_table : 0);
   m.hopf_speed_kmh = s.boundaries_valid ? finite(b.hopf_speed_kmh) : 0.0;
   m.hopf_speed_kmh_low = s.boundaries_valid ? finite(s.hopf_low_kmh) : 0.0;
   m.hopf_speed_kmh_high = s.boundaries_valid ? finite(s.hopf_high_kmh) : 0.0;
@@ -417,7 +437,7 @@ void MonitorRos::onTimer(const ros::TimerEvent&) {
   m.criterion_displacement_exceeded = e.displacement_exceeded;
   status_pub_.publish(m);
 
-  publishLevel(s.level, s.reason, m.reason, s.latched, now);
+  publishLevel(s, m.reason, now);
   if (static_cast<int>(s.level) != last_logged_level_) {
     last_logged_level_ = static_cast<int>(s.level);
     ROS_INFO("hunting_monitor: level %s (%s) at %.1f km/h", hm_level_name(s.level), hm_reason_text(s.reason),
@@ -429,8 +449,9 @@ void MonitorRos::onTimer(const ros::TimerEvent&) {
   updater_.update();
 }
 
-void MonitorRos::publishLevel(hm_level level, hm_reason reason, const std::string& text, bool latched,
-                              const ros::Time& now) {
+void MonitorRos::publishLevel(const hm_assessment& s, const std::string& text, const ros::Time& now) {
+  const hm_level level = s.level;
+  const hm_reason reason = s.reason;
   const bool changed = static_cast<int>(level) != last_published_level_;
   if (changed) {
     std_msgs::UInt8 bare;
@@ -446,7 +467,11 @@ void MonitorRos::publishLevel(hm_level level, hm_reason reason, const std::strin
     a.level = static_cast<uint8_t>(level);
     a.reason_code = static_cast<uint8_t>(reason);
     a.reason = text;
-    a.level_latched = latched;
+    a.level_latched = s.latched;
+    a.level_held = s.held;
+    a.hold_release_below_kmh = finite(s.hold_release_below_kmh);
+    a.hold_calm_s = finite(s.calm_s);
+    a.hold_calm_needed_s = finite(s.calm_needed_s);
     alarm_stamped_pub_.publish(a);
     last_published_reason_ = static_cast<int>(reason);
     last_stamped_at_ = now.toSec();
@@ -461,7 +486,10 @@ void MonitorRos::publishFailure(hm_status st, const ros::Time& now) {
   m.reason_code = HM_REASON_STARTUP;
   m.reason = std::string("the monitor could not update: ") + hm_status_str(st);
   status_pub_.publish(m);
-  publishLevel(HM_LEVEL_NO_DATA, HM_REASON_STARTUP, m.reason, false, now);
+  hm_assessment none{};  // nothing current, nothing held
+  none.level = HM_LEVEL_NO_DATA;
+  none.reason = HM_REASON_STARTUP;
+  publishLevel(none, m.reason, now);
   have_last_ = false;  // the diagnostics say "no data" rather than show the last good status as current
   ROS_ERROR_THROTTLE(5.0, "hunting_monitor: %s", m.reason.c_str());
   updater_.update();
@@ -499,13 +527,13 @@ void MonitorRos::publishMarkers(const hm_monitor_status& st, const ros::Time& no
     std::snprintf(buf, sizeof buf,
                   "%s: %s\nV %.1f km/h  Hopf %.1f [%.1f, %.1f] (%s)  lowest cycle %.1f\n"
                   "amplitude %.2f mm at %.1f Hz  unstable cycle %.2f mm\nconicity %.3f (%s)  decay %s",
-                  hm_level_name(s.level), hm_reason_text(s.reason), e.speed_kmh, s.boundaries.hopf_speed_kmh,
+                  hm_level_name(s.level), reasonText(s).c_str(), e.speed_kmh, s.boundaries.hopf_speed_kmh,
                   s.hopf_low_kmh, s.hopf_high_kmh, hopfMarginWords(s.margin_hopf_kmh).c_str(),
                   s.boundaries.lowest_cycle_speed_kmh,
                   1e3 * e.amplitude_displacement_m, e.frequency_hz, 1e3 * s.edge_used_m, s.conicity,
                   s.conicity_from_estimate ? "identified" : "prior", decay);
   else
-    std::snprintf(buf, sizeof buf, "%s: %s", hm_level_name(s.level), hm_reason_text(s.reason));
+    std::snprintf(buf, sizeof buf, "%s: %s", hm_level_name(s.level), reasonText(s).c_str());
   text.text = buf;
   arr.markers.push_back(text);
   marker_pub_.publish(arr);
@@ -563,9 +591,17 @@ void MonitorRos::diagnoseLevel(diagnostic_updater::DiagnosticStatusWrapper& stat
   const unsigned char d = l == HM_LEVEL_OK || l == HM_LEVEL_WATCH ? diagnostic_msgs::DiagnosticStatus::OK
                           : l == HM_LEVEL_WARN                       ? diagnostic_msgs::DiagnosticStatus::WARN
                                                                      : diagnostic_msgs::DiagnosticStatus::ERROR;
-  stat.summary(d, std::string(hm_level_name(l)) + ": " + hm_reason_text(have_last_ ? s.reason : HM_REASON_STARTUP) +
-                     (have_last_ && s.latched ? " (held until the oscillation stays calm and the speed drops)" : ""));
-  if (have_last_ && s.latched) stat.add("latched: calm still needed [s]", s.release_in_s);
+  stat.summary(d, std::string(hm_level_name(l)) + ": " +
+                     (have_last_ ? reasonText(s) : std::string(hm_reason_text(HM_REASON_STARTUP))));
+  if (have_last_ && s.latched) {
+    stat.add("latched by", std::string(hm_reason_text(s.hold_cause)));
+    stat.add("held (no criterion met now)", static_cast<bool>(s.held));
+    stat.add("release below [km/h]", s.hold_release_below_kmh);
+    stat.add("release: amplitude below [mm]", 1e3 * s.hold_release_amplitude_m);
+    stat.add("calm so far [s]", s.calm_s);
+    stat.add("calm needed [s]", s.calm_needed_s);
+    stat.add("latched: calm still needed [s]", s.release_in_s);
+  }
   if (have_last_ && s.boundaries_valid) {
     stat.add("margin to Hopf [km/h]", s.margin_hopf_kmh);
     stat.add("Hopf interval low [km/h]", s.hopf_low_kmh);
@@ -573,6 +609,9 @@ void MonitorRos::diagnoseLevel(diagnostic_updater::DiagnosticStatusWrapper& stat
     stat.add("margin to lowest cycle speed [km/h]", s.margin_lowest_cycle_kmh);
     stat.add("conicity used", s.conicity);
     stat.add("conicity from identification", static_cast<bool>(s.conicity_from_estimate));
+    if (s.conicity_outside_table)
+      stat.add("conicity outside the table", std::string(s.conicity_outside_table > 0 ? "above: boundaries widened"
+                                                                                      : "below: boundaries widened"));
   }
   const hm_margin_estimate& g = last_.margin;
   if (have_last_) {
@@ -592,7 +631,7 @@ void MonitorRos::diagnoseLevel(diagnostic_updater::DiagnosticStatusWrapper& stat
     } else {
       stat.add("periodic track excitation", std::string("none found"));
     }
-    stat.add("model mismatch", static_cast<bool>(g.model_mismatch));
+    stat.add("model mismatch", static_cast<bool>(s.boundaries_valid ? s.model_mismatch : g.model_mismatch));
     stat.add("misfit windows", g.n_misfits);
     stat.add("windows' Birge ratio", g.birge_ratio);
     stat.add("conicity changes detected", g.n_changes);

@@ -50,7 +50,7 @@ class MonitorRos {
   void publishMarkers(const hm_monitor_status& st, const ros::Time& now);
   // The level on hunting_alarm (bare, on change) and hunting_alarm_stamped (on change of level or reason, and at
   // least once a second).
-  void publishLevel(hm_level level, hm_reason reason, const std::string& text, bool latched, const ros::Time& now);
+  void publishLevel(const hm_assessment& s, const std::string& text, const ros::Time& now);
   // ROS time of a time on the sensor's line.
   double rosTime(double line_s) const { return line_s + hm_clock_offset_s(&clock_); }
   // An update that failed still gives a status (NO_DATA, the reason in words) and the alarm level NO_DATA.

@@ -181,7 +181,41 @@ visualization_msgs::MarkerArray StabilityChart::update(const hm_monitor_status& 
   geometry_msgs::Point tp = at(kSpeedMax / 2, kAmpMax);
   tp.z += 0.95;  // two lines above the family's title
   arr.markers.push_back(label(frame_id_, now, "chart_now", 2, tp, text, 0.18));
+  drawInterval(&arr, s, now);
   return arr;
+}
+
+void StabilityChart::drawInterval(visualization_msgs::MarkerArray* arr, const hm_assessment& s, const ros::Time& now) {
+  // the Hopf interval the level uses, a band on the speed axis in the level's colour
+  const float* c = levelColour(s.level);
+  visualization_msgs::Marker band =
+      base(frame_id_, now, "chart_now", 3, visualization_msgs::Marker::CUBE, c[0], c[1], c[2]);
+  const geometry_msgs::Point lo = at(s.hopf_low_kmh, 0.0), hi = at(s.hopf_high_kmh, 0.0);
+  band.pose.position.x = 0.5 * (lo.x + hi.x);
+  band.pose.position.z = -0.04;  // just below the axis: the family's Hopf point stays visible on it
+  band.scale.x = std::max(hi.x - lo.x, 0.01);
+  band.scale.y = 0.02;
+  band.scale.z = 0.08;
+  band.color.a = 0.6;
+  arr->markers.push_back(band);
+  // while a latched ALARM holds: the speed below which its calm counts, a vertical line, labelled
+  visualization_msgs::Marker release =
+      base(frame_id_, now, "chart_now", 4, visualization_msgs::Marker::LINE_LIST, 0.2f, 0.8f, 1.0f);
+  geometry_msgs::Point top = at(s.hold_release_below_kmh, kAmpMax);
+  top.z += 0.1;
+  visualization_msgs::Marker text = label(frame_id_, now, "chart_now", 5, top, "", 0.14);
+  if (s.latched && std::isfinite(s.hold_release_below_kmh)) {
+    release.scale.x = 0.02;
+    release.points.push_back(at(s.hold_release_below_kmh, 0.0));
+    release.points.push_back(at(s.hold_release_below_kmh, kAmpMax));
+    char words[96];
+    std::snprintf(words, sizeof words, "release below %.1f km/h", s.hold_release_below_kmh);
+    text.text = words;
+  } else {
+    release.action = text.action = visualization_msgs::Marker::DELETE;
+  }
+  arr->markers.push_back(release);
+  arr->markers.push_back(text);
 }
 
 }  // namespace hunting_monitor

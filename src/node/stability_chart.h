@@ -1,6 +1,7 @@
 // The stability chart for rviz: the cycle family at the conicity in use (amplitude max|y| against speed, stable and
-// unstable branches, the Hopf point and the folds labelled, axes with ticks and units) and the operating point with
-// a 30 s trail and the margins. Presentation only: the family and its folds come from the core's table
+// unstable branches, the Hopf point and the folds labelled, axes with ticks and units), the operating point with
+// a 30 s trail and the margins, the Hopf interval the level uses as a band on the speed axis and, while an ALARM is
+// latched, the speed below which it may be released. Presentation only: the family and its folds come from the core's table
 // (hm_table_family); this draws them as markers in ~frame_id, beside the lamp (x: 1 m per 100 km/h from x = 1.5 m;
 // z: 1 m per 4 mm).
 #ifndef HUNTING_MONITOR_STABILITY_CHART_H
@@ -40,6 +41,8 @@ class StabilityChart {
 
  private:
   void drawFamily(visualization_msgs::MarkerArray* arr, double conicity, hm_table table, const ros::Time& now);
+  // The Hopf interval in use as a band on the speed axis and, while an ALARM is latched, its release speed.
+  void drawInterval(visualization_msgs::MarkerArray* arr, const hm_assessment& s, const ros::Time& now);
   std::string frame_id_;
   double drawn_conicity_ = -1.0, drawn_at_ = -1e300;
   size_t drawn_table_size_ = 0;

@@ -346,6 +346,25 @@ def test_tables_and_lookup():
         assert look["origin_stable"] and look["stable_cycle_amplitude_m"] > look["unstable_cycle_amplitude_m"]
         below = run_json("table-lookup", "--table", tbl, "--conicity", "0.1358", "--v", "200")
         assert below["unstable_cycle_amplitude_m"] is None, below  # no cycle below ~239.5 km/h
+        # outside the table (issue #27 item 8): refused, not the end conicity's numbers in silence; --widen the
+        # cautious reading: the Hopf speed the closed form's, the lowest cycle speed and the unstable cycle at or below
+        # the cycle family computed at that conicity (hunting cycles: 226.8 km/h, 7.40 mm at 399.7 km/h)
+        for c, v in (("0.20", "399.7"), ("0.10", "400"), ("0.1358", "100"), ("0.1358", "800")):
+            p = run("table-lookup", "--table", tbl, "--conicity", c, "--v", v, ok=False)
+            assert p.returncode == 1 and "refused" in p.stderr and p.stdout == "", (c, v, p.stderr)
+        assert "outside the table's 0.12..0.16" in run("table-lookup", "--table", tbl, "--conicity", "0.2", "--v",
+                                                        "400", ok=False).stderr
+        wide = run_json("table-lookup", "--table", tbl, "--conicity", "0.20", "--v", "399.7", "--widen")
+        family = run_json("cycles", "--conicity", "0.20", "--v-min", "150", "--v-max", "700", "--amp-max", "0.016")
+        edge = min(a["amplitude_m"] + (399.7 - a["v_kmh"]) / (b["v_kmh"] - a["v_kmh"])
+                   * (b["amplitude_m"] - a["amplitude_m"]) for a, b in zip(family["branch"], family["branch"][1:])
+                   if (a["v_kmh"] - 399.7) * (b["v_kmh"] - 399.7) <= 0 and a["v_kmh"] != b["v_kmh"] and not a["stable"])
+        close(wide["hopf_kmh"], run_json("critical", "--conicity", "0.20")["v_crit_kmh"], 1e-6, "widened Hopf")
+        assert wide["widened"] and wide["conicity"] == 0.2 and wide["table_conicity"] == 0.16, wide
+        assert wide["lowest_cycle_kmh"] <= family["lowest_cycle_v_kmh"], (wide, family["lowest_cycle_v_kmh"])
+        assert 0.8 * edge < wide["unstable_cycle_amplitude_m"] <= edge, (wide, edge)
+        inside = run_json("table-lookup", "--table", tbl, "--conicity", "0.1358", "--v", "420", "--widen")
+        assert inside == look, (inside, look)  # inside the table --widen is the lookup
         bad = os.path.join(d, "bad.tbl")
         with open(bad, "w") as f:
             f.write("hunting_monitor_boundary_table 1\nkx_mn_m 8.96\n")
@@ -472,6 +491,36 @@ def test_estimate_bad_and_stale_input():
         p = run("estimate", "--accel", acc, "--v", "300", "--table",
                 write("zero.tbl", head + "conicity " + " ".join(words[0:]) + "\n" + points), ok=False)
         assert p.returncode == 1 and "hopf_kmh must be in (0, 3000]" in p.stderr, p.stderr
+
+
+def test_estimate_last_line_counts_everything():
+    # issue #27 item 8: the last line holds every input counter, rows refused after the last periodic line included
+    # (the data end on a line's time, 3.0 s, then a row without a time and one out of order: the last line had said 0
+    # refused); references: what this test wrote into the files
+    with tempfile.TemporaryDirectory() as d:
+        acc, spd = os.path.join(d, "a.csv"), os.path.join(d, "s.csv")
+        n = 6001  # 0 .. 3.0 s at 2 kHz
+        with open(acc, "w") as f:
+            f.write("t_s,accel_mps2\n")
+            f.write("".join(f"{i / 2000:.4f},{2.0 * math.sin(2 * math.pi * 14 * i / 2000):.6f}\n" for i in range(n)))
+            f.write("nan,1.0\n2.5,1.0\n")  # refused: no time, out of order
+        with open(spd, "w") as f:  # 0 .. 3.0 s at 10 Hz, one value and one time not a number, three rows after
+            f.write("t_s,speed_kmh\n")  # the end (a row without a time had stopped the speeds after it: NO_DATA)
+            f.write("".join(f"{i / 10:.1f},{'nan' if i == 5 else '400'}\n" + ("nan,400\n" if i == 10 else "")
+                            for i in range(31)))
+            f.write("3.5,400\nnan,400\n4.0,400\n")
+        out = lines(run("estimate", "--accel", acc, "--speed", spd, "--table", shipped_table(), "--every", "0.5").stdout)
+        last = out[-1]
+        counts = {k: last[k] for k in ("accel_rows", "accel_samples", "rejected_samples", "rejected_nonfinite",
+                                       "rejected_out_of_range", "rejected_out_of_order", "speed_rows",
+                                       "speed_updates", "rejected_speeds", "speed_rows_unused")}
+        assert counts == {"accel_rows": n + 2, "accel_samples": n, "rejected_samples": 2, "rejected_nonfinite": 1,
+                          "rejected_out_of_range": 0, "rejected_out_of_order": 1, "speed_rows": 35,
+                          "speed_updates": 32, "rejected_speeds": 2, "speed_rows_unused": 3}, counts
+        close(last["t_s"], 3.0, 1e-9, "the last line at the last sample's time")
+        assert last["level"] != "NO_DATA" and last["speed_valid"], last
+        for key in ("gaps", "samples_lost", "rate_changes"):
+            assert last[key] == 0, (key, last[key])
 
 
 def test_estimate_streams_long_recordings():

@@ -14,7 +14,7 @@ import unittest
 import rospy
 import rostest
 from diagnostic_msgs.msg import DiagnosticArray
-from hunting_monitor.msg import HuntingStatus
+from hunting_monitor.msg import HuntingAlarm, HuntingStatus
 from std_msgs.msg import UInt8
 from visualization_msgs.msg import MarkerArray
 
@@ -24,7 +24,7 @@ LEVELS = ["NO_DATA", "OK", "WATCH", "WARN", "ALARM"]
 
 
 class Replay(unittest.TestCase):
-    status, diagnostics, markers, chart, nodelet_status = [], [], [], [], []
+    status, diagnostics, markers, chart, nodelet_status, stamped = [], [], [], [], [], []
     reference = []
 
     @classmethod
@@ -42,6 +42,7 @@ class Replay(unittest.TestCase):
         rospy.Subscriber("hunting_markers", MarkerArray, keep(cls.markers), queue_size=100)
         rospy.Subscriber("hunting_chart", MarkerArray, keep(cls.chart), queue_size=1000)
         rospy.Subscriber("/nodelet/hunting_status", HuntingStatus, keep(cls.nodelet_status), queue_size=1000)
+        rospy.Subscriber("hunting_alarm_stamped", HuntingAlarm, keep(cls.stamped), queue_size=1000)
         deadline = time.time() + 150.0
         while time.time() < deadline:
             with lock:
@@ -233,6 +234,48 @@ class Replay(unittest.TestCase):
         points = [m.pose.position for a in self.chart for m in a.markers if m.ns == "chart_now" and m.id == 0]
         self.assertTrue(points, "no operating point")
         self.assertTrue(all(1.5 <= p.x <= 8.5 and 0.0 <= p.z <= 4.0 for p in points), "operating point off the chart")
+
+    def test_published_fields_agree(self):
+        """Issue #27 item 7: every data status's interval holds its point; a hunted-at speed bounds the lower end, and
+        WARN and WATCH lie below it by their margins (10 and 30 km/h); while latched they lie below the lower end by
+        them too, and the release speed is the lower end less the 3 km/h hysteresis, the calm still needed the calm needed (10 s) less the calm so far; a held status's
+        reason says it is held and its code is the hold's cause; the stamped alarm carries its status's reason and hold;
+        the chart's band spans the status's interval (1 m per 100 km/h from x = 1.5 m)."""
+        seq = [m for m in self.data_statuses() if m.boundaries_valid]
+        self.assertTrue(seq)
+        latched = [m for m in seq if m.level_latched]
+        for m in seq:
+            self.assertLessEqual(m.hopf_speed_kmh_low, m.hopf_speed_kmh + 1e-9)
+            self.assertLessEqual(m.hopf_speed_kmh, m.hopf_speed_kmh_high + 1e-9)
+            if m.hunted_at_kmh > 0:
+                self.assertLessEqual(m.hopf_speed_kmh_low, m.hunted_at_kmh + 1e-9)
+                self.assertLessEqual(m.warn_from_kmh, m.hunted_at_kmh - 10.0 + 1e-9)
+                self.assertLessEqual(m.watch_from_kmh, m.hunted_at_kmh - 30.0 + 1e-9)
+        for m in latched:
+            self.assertAlmostEqual(m.hold_release_below_kmh, m.hopf_speed_kmh_low - 3.0, delta=1e-6)
+            if m is not latched[0]:  # (from the update after the one that latched it)
+                self.assertLessEqual(m.warn_from_kmh, m.hopf_speed_kmh_low - 10.0 + 1e-9)
+                self.assertLessEqual(m.watch_from_kmh, m.hopf_speed_kmh_low - 30.0 + 1e-9)
+            self.assertAlmostEqual(m.hold_calm_needed_s, 10.0, delta=1e-9)
+            self.assertAlmostEqual(m.latch_release_in_s, m.hold_calm_needed_s - m.hold_calm_s, delta=1e-6)
+            self.assertTrue(m.hold_cause, m.reason)
+            if m.level_held:
+                self.assertTrue(m.reason.startswith("held (") and "releases below" in m.reason, m.reason)
+                self.assertEqual(m.reason_code, m.hold_cause_code)
+        by_stamp = {m.header.stamp: m for m in self.status}
+        pairs = [(a, by_stamp[a.header.stamp]) for a in self.stamped if a.header.stamp in by_stamp]
+        self.assertTrue(pairs, "no stamped alarm with its status")
+        for a, m in pairs:
+            self.assertEqual((a.level, a.reason_code, a.reason, a.level_latched, a.level_held),
+                             (m.level, m.reason_code, m.reason, m.level_latched, m.level_held))
+            self.assertAlmostEqual(a.hold_release_below_kmh, m.hold_release_below_kmh, delta=1e-9)
+        bands = [(m.header.stamp, m) for a in self.chart for m in a.markers
+                 if m.ns == "chart_now" and m.id == 3]
+        matched = [(by_stamp[t], b) for t, b in bands if t in by_stamp and by_stamp[t].boundaries_valid]
+        self.assertTrue(matched, "no interval band on the chart")
+        for m, b in matched:
+            self.assertAlmostEqual(b.pose.position.x - b.scale.x / 2, 1.5 + 0.01 * m.hopf_speed_kmh_low, delta=1e-6)
+            self.assertAlmostEqual(b.pose.position.x + b.scale.x / 2, 1.5 + 0.01 * m.hopf_speed_kmh_high, delta=1e-6)
 
     def test_alarm_is_latched(self):
         got = []

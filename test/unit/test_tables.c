@@ -29,18 +29,35 @@ enum { CAP = 5000 };
 
 /* The cycle family of the test vehicle (lambda(0) = 0.1358) computed directly with the tables' settings (150-700
  * km/h, up to 16 mm); *o gets the options used. */
-static hm_cycle_point *direct_family(size_t *np, hm_cycle_event *ev, size_t *ne, hm_cycle_options *o) {
+static hm_cycle_point *direct_family_of(const hm_vehicle *veh, size_t *np, hm_cycle_event *ev, size_t *ne,
+                                        hm_cycle_options *o) {
   hm_hopf_point h;
   size_t n;
-  HM_CHECK(hm_hopf_find(&vehicle, 500.0, HM_PARAM_SPEED, 100.0, 900.0, 1e-10, &h, 1, &n) == HM_OK && n == 1, "Hopf");
+  HM_CHECK(hm_hopf_find(veh, 500.0, HM_PARAM_SPEED, 100.0, 900.0, 1e-10, &h, 1, &n) == HM_OK && n == 1, "Hopf");
   hm_cycle_options_default(o, HM_PARAM_SPEED);
   o->p_min = 150.0;
   o->p_max = 700.0;
   o->amp_max_m = 0.016;
   hm_cycle_point *pts = malloc(CAP * sizeof *pts);
   *np = *ne = 0;
-  HM_CHECK(hm_cycles_continue(&vehicle, 500.0, &h, o, pts, CAP, np, ev, 16, ne, NULL) == HM_OK, "family");
+  HM_CHECK(hm_cycles_continue(veh, 500.0, &h, o, pts, CAP, np, ev, 16, ne, NULL) == HM_OK, "family");
   return pts;
+}
+
+static hm_cycle_point *direct_family(size_t *np, hm_cycle_event *ev, size_t *ne, hm_cycle_options *o) {
+  return direct_family_of(&vehicle, np, ev, ne, o);
+}
+
+/* The smallest unstable cycle's amplitude at a speed on a directly continued family (INFINITY: none). */
+static double direct_edge(const hm_cycle_point *pts, size_t np, double v_kmh) {
+  double edge = INFINITY;
+  for (size_t i = 1; i < np; ++i) {
+    const hm_cycle_point *a = &pts[i - 1], *b = &pts[i];
+    if ((a->param - v_kmh) * (b->param - v_kmh) > 0.0 || a->stable || b->stable) continue;
+    const double f = (v_kmh - a->param) / (b->param - a->param);
+    edge = fmin(edge, a->amp_y_m + f * (b->amp_y_m - a->amp_y_m));
+  }
+  return edge;
 }
 
 /* At lambda(0) = 0.1358 (between grid points): MODEL.md section 7 and a direct continuation agree with the
@@ -61,13 +78,7 @@ static void lookup_matches_direct_continuation(void) {
   hm_cycle_point *pts = direct_family(&np, ev, &ne, &o);
   const double speeds[] = {300.0, 400.0, 480.0};
   for (int k = 0; k < 3; ++k) {
-    double edge = INFINITY;
-    for (size_t i = 1; i < np; ++i) {
-      const hm_cycle_point *a = &pts[i - 1], *b = &pts[i];
-      if ((a->param - speeds[k]) * (b->param - speeds[k]) > 0.0 || a->stable || b->stable) continue;
-      const double f = (speeds[k] - a->param) / (b->param - a->param);
-      edge = fmin(edge, a->amp_y_m + f * (b->amp_y_m - a->amp_y_m));
-    }
+    const double edge = direct_edge(pts, np, speeds[k]);
     HM_CHECK(hm_table_lookup(table, 0.1358, speeds[k], &r) == HM_OK, "lookup");
     printf("  V %.0f: edge direct %.4f mm, table %.4f mm\n", speeds[k], edge * 1e3, r.edge_amp_m * 1e3);
     HM_CHECK(isfinite(edge), "no unstable cycle at %g km/h on the direct family", speeds[k]);
@@ -75,6 +86,51 @@ static void lookup_matches_direct_continuation(void) {
     HM_CHECK_DELTA(r.edge_amp_m, edge, 10e-6, "edge amplitude against direct continuation");
   }
   free(pts);
+}
+
+/* Outside the table's conicities (0.12-0.16) the widened lookup is on the cautious side of the truth (issue #27 item 8):
+ * against the family continued directly at 0.18, 0.20 and 0.25 (worn beyond the table) and 0.11 and 0.10 (new), the
+ * Hopf speed the closed form's (1e-9), the lowest cycle speed and the edge at 0.6, 0.8 and 0.95 of the Hopf speed at
+ * or below the direct family's; where the clamped lookup (the end conicity's, as the monitor took it) was not: at 0.20
+ * its lowest cycle speed 234.5 km/h for the family's 226.8, its edge at 400 km/h 8.13 mm for 7.40. */
+static void widened_lookup_is_cautious_outside(void) {
+  const double conicities[5] = {0.18, 0.20, 0.25, 0.11, 0.10};
+  int clamped_below = 1; /* the clamped lookup was at or below the truth everywhere */
+  for (int k = 0; k < 5; ++k) {
+    hm_vehicle veh = vehicle;
+    HM_CHECK(hm_vehicle_set_conicity_at_zero(&veh, conicities[k]) == HM_OK, "conicity %g", conicities[k]);
+    hm_cycle_options o;
+    hm_cycle_event ev[16];
+    size_t np = 0, ne = 0;
+    hm_cycle_point *pts = direct_family_of(&veh, &np, ev, &ne, &o);
+    const double lowest = hm_cycles_lowest(pts, np, ev, ne), hopf = hm_linear_hopf_kmh(&veh, conicities[k]);
+    hm_table_lookup_result w, c;
+    HM_CHECK(hm_table_lookup_widened(table, conicities[k], 300.0, &w) == HM_OK && w.widened && w.clamped, "widened");
+    HM_CHECK_REL(w.hopf_speed_kmh, hopf, 1e-9, "the widened Hopf speed against the closed form");
+    HM_CHECK(hm_table_lookup(table, conicities[k], 300.0, &c) == HM_OK && c.clamped && !c.widened, "clamped");
+    printf("  %.2f: Hopf %.1f km/h, lowest cycle speed direct %.1f, widened %.1f, clamped %.1f\n", conicities[k], hopf,
+           lowest, w.lowest_cycle_speed_kmh, c.lowest_cycle_speed_kmh);
+    HM_CHECK(w.lowest_cycle_speed_kmh <= lowest, "%.2f: lowest cycle speed %.1f above the family's %.1f",
+             conicities[k], w.lowest_cycle_speed_kmh, lowest);
+    clamped_below &= c.lowest_cycle_speed_kmh <= lowest;
+    const double fractions[3] = {0.6, 0.8, 0.95};
+    for (int j = 0; j < 3; ++j) {
+      const double v = fractions[j] * hopf, edge = direct_edge(pts, np, v);
+      HM_CHECK(hm_table_lookup_widened(table, conicities[k], v, &w) == HM_OK && hm_table_lookup(table, conicities[k],
+               v, &c) == HM_OK, "lookups");
+      printf("     at %.1f km/h: edge direct %.3f mm, widened %.3f, clamped %s%.3f\n", v, 1e3 * edge,
+             w.has_edge ? 1e3 * w.edge_amp_m : NAN, c.has_edge && c.origin_stable ? "" : "(origin unstable) ",
+             1e3 * c.edge_amp_m);
+      HM_CHECK(isfinite(edge) && w.has_edge && w.origin_stable && w.edge_amp_m <= edge && w.edge_amp_m > 0.8 * edge,
+               "%.2f at %.1f km/h: widened edge %.4f mm, direct %.4f", conicities[k], v, 1e3 * w.edge_amp_m, 1e3 * edge);
+      clamped_below &= c.has_edge && c.edge_amp_m <= edge;
+    }
+    free(pts);
+  }
+  HM_CHECK(!clamped_below, "the clamped lookup was already cautious everywhere: the reference shows nothing");
+  hm_table_lookup_result r;
+  HM_CHECK(hm_table_lookup_widened(table, 0.13, 400.0, &r) == HM_OK && !r.widened && !r.clamped, "inside: a lookup");
+  HM_CHECK(hm_table_lookup_widened(table, NAN, 400.0, &r) == HM_EDOMAIN, "NaN");
 }
 
 /* format -> parse -> format reproduces the text; lookups agree. */
@@ -346,6 +402,7 @@ int main(void) {
   }
   HM_RUN(hopf_lookup_is_exact);
   HM_RUN(lookup_matches_direct_continuation);
+  HM_RUN(widened_lookup_is_cautious_outside);
   HM_RUN(round_trip);
   HM_RUN(malformed_tables);
   HM_RUN(table_checked_against_vehicle);
