@@ -387,7 +387,9 @@ static void the_file_and_its_previous_one(void) {
   hm_monitor_destroy(b);
 }
 
-int main(void) {
+/* test_state --write-seed FILE also writes the record of restart_continues_the_assessment to FILE (the fuzz seed,
+ * test/fuzz/seed_state.bin). */
+int main(int argc, char **argv) {
   hm_vehicle_default(&vehicle);
   hm_table table = NULL;
   if (hm_test_small_table(&table) != HM_OK) {
@@ -400,6 +402,7 @@ int main(void) {
   hm_table_destroy(table);
   HM_RUN(checksum_is_crc32);
   HM_RUN(restart_continues_the_assessment);
+  if (argc == 3 && strcmp(argv[1], "--write-seed") == 0) write_bytes(argv[2], good, good_len);
   HM_RUN(held_alarm_and_hunted_speed_restored);
   HM_RUN(refusals_leave_the_monitor_untouched);
   HM_RUN(the_file_and_its_previous_one);
