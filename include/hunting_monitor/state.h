@@ -138,8 +138,9 @@ hm_status hm_state_save_file(const hm_monitor m, const char *path, double now_s,
                              size_t why_len);
 /* Restore m from path (hm_state_restore) or, where it is missing or refused, from path.prev: *outcome says which was
  * restored and why the others were not ("restored from FILE.prev, age 44 s, 3 windows (FILE: truncated: ...)", "not
- * restored: FILE: ...; FILE.prev: no file"). HM_OK when one was restored; else hm_state_restore's status for path's
- * refusal, or HM_EIO when neither file exists or can be read. */
+ * restored: FILE: ...; FILE.prev: no file", "not restored: FILE (and .prev): ..." for one reason). HM_OK when one
+ * was restored; else hm_state_restore's status for path's refusal, or HM_EIO when neither file exists or can be read.
+ */
 hm_status hm_state_restore_file(hm_monitor m, const char *path, double now_s, double now_unix_s, hm_state_clock clock,
                                 hm_state_outcome *outcome);
 

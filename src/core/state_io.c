@@ -165,6 +165,7 @@ hm_status hm_state_restore_file(hm_monitor m, const char *path, double now_s, do
   const int none = o1.verdict == HM_STATE_NO_FILE && o2.verdict == HM_STATE_NO_FILE;
   *out = o1.verdict == HM_STATE_NO_FILE ? o2 : o1;
   if (none) say(out->text, sizeof out->text, "not restored: no state file (%s)", path);
+  else if (strcmp(r1, r2) == 0) say(out->text, sizeof out->text, "not restored: %s (and .prev): %s", path, r1);
   else say(out->text, sizeof out->text, "not restored: %s: %s; %s: %s", path, r1, prev, r2);
   return o1.verdict != HM_STATE_NO_FILE && o1.verdict != HM_STATE_UNREADABLE ? s1 : s2;
 }
