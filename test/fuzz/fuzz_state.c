@@ -8,6 +8,7 @@
 #include <stdint.h>
 #include <string.h>
 
+#include "fuzz_monitor.h"
 #include "hunting_monitor/state.h"
 
 static hm_monitor monitor;
@@ -64,12 +65,7 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size) {
   if (!monitor) {
     hm_monitor_config c;
     hm_monitor_config_default(&c);
-    hm_vehicle v;
-    hm_vehicle_default(&v);
-    hm_table t = NULL;
-    if (hm_table_load_file(HM_SOURCE_DIR "/config/crh380_default.tbl", &t, NULL, 0) != HM_OK ||
-        hm_monitor_create(&c, &v, t, &monitor, NULL, 0) != HM_OK)
-      __builtin_trap();
+    monitor = fuzz_monitor_create(&c);
     blank.margin.narrow_age_s = blank.margin.ambiguous_age_s = INFINITY;
     blank.alarm.hunted_at_kmh = INFINITY;
   }
