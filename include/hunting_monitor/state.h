@@ -103,6 +103,7 @@ typedef struct {
   double age_s;        /* the record's age on the clock used [s]; NAN when it was refused before */
   unsigned n_windows;  /* windows restored that are within memory_s now */
   int latched;         /* a held ALARM was restored */
+  int from_prev;       /* hm_state_restore_file: restored from FILE.prev (FILE was missing or refused) */
   char text[HM_STATE_TEXT_MAX]; /* "restored, age 42 s, 3 windows" (and "; ALARM held: <cause>", "; hunted at <v>
                                    km/h"), or "not restored: <reason>" */
 } hm_state_outcome;

@@ -159,6 +159,7 @@ hm_status hm_state_restore_file(hm_monitor m, const char *path, double now_s, do
   const hm_status s2 = restore_one(m, prev, now_s, now_unix_s, clock, &o2, r2, sizeof r2);
   if (s2 == HM_OK) {
     *out = o2;
+    out->from_prev = 1;
     say(out->text, sizeof out->text, "restored from %s, %s (%s: %s)", prev, r2 + strlen("restored, "), path, r1);
     return HM_OK;
   }

@@ -7,7 +7,6 @@
 
 #include <sys/stat.h>
 
-#include <cerrno>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
@@ -681,6 +680,7 @@ void MonitorRos::restoreState(const ros::Time& now) {
       hm_state_restore_file(monitor_, state_file_.c_str(), lineTime(now), wall_s, HM_STATE_CLOCK_WALL, &o);
   state_outcome_ = o.text;
   state_verdict_ = static_cast<int>(o.verdict);
+  state_from_prev_ = o.from_prev != 0;
   if (st == HM_OK || o.verdict == HM_STATE_NO_FILE)
     ROS_INFO("hunting_monitor: state file %s: %s", state_file_.c_str(), o.text);
   else
@@ -708,7 +708,7 @@ void MonitorRos::diagnoseState(diagnostic_updater::DiagnosticStatusWrapper& stat
   // refused, or restored from FILE.prev (FILE was refused): WARN
   const bool refused = (state_verdict_ > static_cast<int>(HM_STATE_RESTORED) &&
                         state_verdict_ != static_cast<int>(HM_STATE_NO_FILE)) ||
-                       state_outcome_.compare(0, 14, "restored from ") == 0;
+                       state_from_prev_;
   if (!state_write_error_.empty())
     stat.summary(DiagnosticStatus::ERROR, "the state could not be written: " + state_write_error_);
   else if (state_verdict_ == static_cast<int>(HM_STATE_NO_FILE))

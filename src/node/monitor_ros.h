@@ -106,6 +106,7 @@ class MonitorRos {
   bool state_restore_pending_ = false;  // enabled and not restored yet (nothing is written before)
   std::string state_outcome_;           // what the restore did (hm_state_outcome's text)
   int state_verdict_ = -1;              // its hm_state_verdict (-1 before)
+  bool state_from_prev_ = false;        // restored from FILE.prev: FILE was missing or refused
   double next_state_write_ = 0.0;       // wall time of the next write
   double last_line_s_ = 0.0, last_wall_s_ = 0.0;  // the last update's time (sensor line) and wall time
   bool have_update_ = false;

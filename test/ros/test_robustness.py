@@ -259,6 +259,7 @@ class Robustness(unittest.TestCase):
             ("bad_key", [("vehicle", "mas_kg", 1)], [], "vehicle.mas_kg: unknown key"),
             ("bad_time", [], ["_time_source:=gps"], "~time_source must be header or receipt"),
             ("bad_clock", [], ["_clock/window_s:=-1"], "~clock.window_s: must be in (0, 3600]"),
+            ("bad_state", [], ["_state_period_s:=0"], "~state_period_s: state.period_s: must be in [0.1, 3600]"),
         ]
         for name, changes, extra, message in cases:
             code, out = self.run_bad_node(name, changes, extra)

@@ -351,7 +351,7 @@ static void the_file_and_its_previous_one(void) {
   write_bytes(path, good, good_len / 2);
   HM_CHECK(hm_state_restore_file(b, path, 100.0, WALL0 + 3.0, HM_STATE_CLOCK_WALL, &o) == HM_OK &&
                strstr(o.text, "restored from ") && strstr(o.text, "state.prev, age 3 s, 1 window (") &&
-               strstr(o.text, "/state: truncated: 100 of 200 bytes)"),
+               strstr(o.text, "/state: truncated: 100 of 200 bytes)") && o.from_prev,
            "from prev: %s", o.text);
   printf("  %s\n", o.text);
   write_bytes(prev, (const unsigned char *)"x", 1);
