@@ -46,7 +46,8 @@
  *                8  f64 hunted_age_s (NaN: counted from the next update); 4 u32 precise
  *     length - 4  4  u32 CRC-32 (IEEE 802.3, as zlib's crc32) of every byte before it
  * The magic, the version and the length at the front and the CRC-32 at the end are the same in every version.
- * No allocation; no I/O.
+ * hm_state_save and hm_state_restore allocate nothing and do no I/O; hm_state_save_file allocates nothing,
+ * hm_state_restore_file reads a file into an allocation of its size (at start).
  */
 #ifndef HUNTING_MONITOR_STATE_H
 #define HUNTING_MONITOR_STATE_H
