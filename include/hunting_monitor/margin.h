@@ -192,6 +192,48 @@ void hm_margin_read(const hm_margin m, double now_s, hm_margin_estimate *out);
  * when the linear model is stable at every speed there. */
 double hm_margin_hopf_kmh(const hm_margin m, double conicity);
 
+/* What the margin has learned, as plain data whose times are ages before a "now" [s] (state.h keeps it through a
+ * restart, onto any time line): the windows held within memory_s, oldest first (the provisional one among them as
+ * committed: a restart ends its stretch, as a gap does), the misfit windows within memory_s (the provisional one's
+ * too), the change state, and what the latest window's narrow peak was taken for with the latest ambiguous one (which
+ * holds WATCH, alarm.h). The conicity estimate and both Hopf intervals are not in it: they are computed from the
+ * windows, the same as before. */
+typedef struct {
+  double age_s;                       /* now - the window's end [s] */
+  double speed_kmh;                   /* its mean speed */
+  double window_s;                    /* its length [s] */
+  double sigma_1_s, sigma_stat_1_s;   /* the decay rate used (< 0) and its statistical error [1/s] */
+  double conicity, conicity_se;       /* the window's conicity and its total error */
+  double conicity_stat, conicity_sys; /* the statistical and systematic parts of that error */
+} hm_margin_window;
+
+typedef struct {
+  unsigned n_windows;
+  hm_margin_window windows[HM_MARGIN_MAX_WINDOWS]; /* oldest first */
+  unsigned n_misfits;
+  double misfit_age_s[HM_MARGIN_MAX_WINDOWS];     /* ages of the misfit windows' ends [s] */
+  unsigned long n_changes;                        /* conicity changes detected */
+  double last_change_age_s;                       /* the last one's age [s] (0 when n_changes is 0) */
+  unsigned windows_since_change;                  /* windows stored since it (the one that showed it included) */
+  hm_narrow_verdict narrow;                       /* the latest window's narrow peak: its verdict, frequency [Hz] */
+  double narrow_peak_hz, narrow_age_s;            /* and its window's age [s] (INFINITY: no window yet) */
+  double ambiguous_age_s;                         /* the latest ambiguous narrow peak's window age [s] (INFINITY:
+                                                     none) */
+} hm_margin_snapshot;
+
+/* What m holds as of now_s (its time line), ages clamped at 0; nothing is written for NULL or a non-finite now_s. */
+void hm_margin_take_snapshot(const hm_margin m, double now_s, hm_margin_snapshot *out);
+/* Every field in its range (HM_EDOMAIN, "field: reason" in why): counts at most HM_MARGIN_MAX_WINDOWS, ages finite
+ * and >= 0 (the narrow and ambiguous ones may be INFINITY), speeds in (0, 2000] km/h, windows in (0, 3600] s, decay
+ * rates in [-1e4, 0] with errors in [1e-12, 1e4] 1/s, conicities in (0, 100] with errors in [1e-12, 100] and parts
+ * in [0, 100], the verdict one of hm_narrow_verdict, its frequency in [0, 1e4] Hz: values the margin's sums keep
+ * finite. */
+hm_status hm_margin_snapshot_validate(const hm_margin_snapshot *snap, char *why, size_t why_len);
+/* Replace what m holds by snap, its ages counted back from now_s (m's time line): as hm_margin_reset, then the windows,
+ * misfits, changes and narrow-peak verdicts of snap. HM_EINVAL for NULL or a non-finite now_s, HM_EDOMAIN (reason in
+ * why) for an invalid snap; m untouched on failure. */
+hm_status hm_margin_restore(hm_margin m, double now_s, const hm_margin_snapshot *snap, char *why, size_t why_len);
+
 #ifdef __cplusplus
 }
 #endif

@@ -129,6 +129,25 @@ void hm_monitor_table_failed(hm_monitor m, double conicity);
  * which is not used (*replaced is then NULL). */
 hm_status hm_monitor_replace_table(hm_monitor m, hm_table table, hm_table *replaced, char *why, size_t why_len);
 
+/* The vehicle the monitor was made for. */
+void hm_monitor_vehicle(const hm_monitor m, hm_vehicle *veh);
+
+/* What the monitor has learned, kept through a restart (state.h writes it as bytes): the margin's windows, misfits,
+ * change state and narrow-peak verdicts, and the alarm's latch, hunted-at speed and hysteresis, with times as ages
+ * before a "now" [s]. The stream (estimator, identification, the steady stretch) is not in it: it restarts. */
+typedef struct {
+  hm_margin_snapshot margin;
+  hm_alarm_snapshot alarm;
+} hm_monitor_snapshot;
+
+/* What m holds as of now_s (its time line); nothing is written for NULL or a non-finite now_s. */
+void hm_monitor_take_snapshot(const hm_monitor m, double now_s, hm_monitor_snapshot *out);
+/* Replace what m has learned by snap, its ages counted back from now_s (m's time line, which may be another than the
+ * one snap was taken on): the stream restarts (as at hm_monitor_reset), then the margin and the alarm take snap's
+ * (hm_margin_restore, hm_alarm_restore; a held ALARM is held again). HM_EINVAL for NULL or a non-finite now_s,
+ * HM_EDOMAIN (reason in why) for an invalid snap, checked as a whole first: m untouched on failure. */
+hm_status hm_monitor_restore(hm_monitor m, double now_s, const hm_monitor_snapshot *snap, char *why, size_t why_len);
+
 #ifdef __cplusplus
 }
 #endif

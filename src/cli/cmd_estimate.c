@@ -3,11 +3,13 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <time.h>
 
 #include "cli.h"
 #include "hunting_monitor/config.h"
 #include "hunting_monitor/linear.h"
 #include "hunting_monitor/monitor.h"
+#include "hunting_monitor/state.h"
 #include "hunting_monitor/tables.h"
 #include "hunting_monitor/threads.h"
 
@@ -18,6 +20,10 @@ const cli_option estimate_opts[] = {
     {"monitor", "FILE", "estimator and alarm settings (default: built-in = config/monitor.yaml)"},
     {"table", "FILE", "boundary table from 'hunting tables' (default: computed at start, 36 conicities in about 0.6 s)"},
     {"every", "SECONDS", "output interval in data time (default 0.1)"},
+    {"state-in", "FILE", "restore what a run learned from FILE (or FILE.prev) at the first sample (above)"},
+    {"state-out", "FILE", "write what the run learned to FILE (atomically, keeping FILE.prev) every --state-every"},
+    {"state-every", "SECONDS", "recording time between --state-out writes, and one at the end (default 2)"},
+    {"state-clock", "CLOCK", "recording (default) or wall: the clock a --state-in file's age is read on (above)"},
     CLI_VEHICLE_OPTIONS,
     {NULL, NULL, NULL}};
 
@@ -46,7 +52,8 @@ typedef struct {
   unsigned long speed_rows_unused;      /* speed rows after the acceleration's last sample: not given to the monitor */
 } read_counts;
 
-static void write_line(const hm_monitor_status *st, double t, const read_counts *rc) {
+/* One JSON line; restored (the --state-in outcome) is written when not NULL. */
+static void write_line(const hm_monitor_status *st, double t, const read_counts *rc, const char *restored) {
   const hm_estimate *e = &st->estimate;
   const hm_assessment *s = &st->assessment;
   const hm_margin_estimate *g = &st->margin;
@@ -55,6 +62,7 @@ static void write_line(const hm_monitor_status *st, double t, const read_counts 
   jw_init(&w, stdout);
   jw_object(&w, NULL);
   jw_number(&w, "t_s", t);
+  if (restored) jw_string(&w, "restored", restored);
   jw_string(&w, "level", hm_level_name(s->level));
   jw_int(&w, "reason_code", (long)s->reason);
   char reason[512];
@@ -231,7 +239,25 @@ typedef struct {
   double spd_next[2];
   int spd_have;
   read_counts counts;
+  const char *restored;  /* the --state-in outcome, for the first line (then NULL) */
+  const char *state_out; /* --state-out FILE or NULL */
+  double state_every, next_state;
+  int state_failed;      /* a write failed (said once): the run's exit status is 1 */
 } run_state;
+
+/* The wall clock [s since the epoch]. */
+static double wall_clock_s(void) {
+  struct timespec ts;
+  return timespec_get(&ts, TIME_UTC) == TIME_UTC ? (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec : NAN;
+}
+
+/* What the monitor has learned into --state-out at recording time t. */
+static void write_state(run_state *r, double t) {
+  char why[512] = "";
+  if (hm_state_save_file(r->mon, r->state_out, t, wall_clock_s(), why, sizeof why) == HM_OK || r->state_failed) return;
+  fprintf(stderr, "hunting estimate: --state-out: %s\n", *why ? why : "the state could not be written");
+  r->state_failed = 1;
+}
 
 /* The speed file's rows up to time t into the monitor (one row of look-ahead in r->spd_next; the first was read and
  * counted before; a row without a finite time at once, for the monitor to refuse and count); with t infinite the
@@ -276,12 +302,50 @@ static int process_row(run_state *r, const double *row, int last_row) {
   hm_monitor_status st;
   if (isfinite(t) && (t >= r->next_out || last_row) && hm_monitor_update(r->mon, t, &st) == HM_OK) {
     refine_table(r);
-    write_line(&st, t, &r->counts);
+    write_line(&st, t, &r->counts, r->restored);
+    r->restored = NULL;
     r->t_written = t;
     r->since_line = 0;
     if (t >= r->next_out) r->next_out = t + r->every - fmod(t - r->next_out, r->every);
   }
+  if (r->state_out && isfinite(t)) { /* every state_every of recording time */
+    if (!isfinite(r->next_state)) r->next_state = t + r->state_every;
+    if (t >= r->next_state) {
+      write_state(r, t);
+      r->next_state = t + r->state_every;
+    }
+  }
   return 0;
+}
+
+/* --state-out, --state-every and --state-clock into r and *clock; nonzero (said) for a bad value. */
+static int state_options(const cli_args *a, run_state *r, hm_state_clock *clock) {
+  hm_state_config sc;
+  hm_state_config_default(&sc);
+  char why[160] = "";
+  if (cli_number(a, "state-every", &sc.period_s)) return 1;
+  if (hm_state_config_validate(&sc, why, sizeof why) != HM_OK) {
+    fprintf(stderr, "hunting estimate: --state-every: %s\n", why);
+    return 1;
+  }
+  r->state_every = sc.period_s;
+  r->state_out = cli_value(a, "state-out");
+  const char *c = cli_value(a, "state-clock");
+  *clock = c && strcmp(c, "wall") == 0 ? HM_STATE_CLOCK_WALL : HM_STATE_CLOCK_LINE;
+  if (c && strcmp(c, "wall") != 0 && strcmp(c, "recording") != 0) {
+    fprintf(stderr, "hunting estimate: --state-clock must be recording or wall, got '%s'\n", c);
+    return 1;
+  }
+  return 0;
+}
+
+/* --state-in restored at the first sample's time t0 (or refused: the prior), said on stderr; the outcome's text in
+ * text for the first line. */
+static void restore_state(const char *path, hm_monitor mon, double t0, hm_state_clock clock, char *text, size_t len) {
+  hm_state_outcome o;
+  hm_state_restore_file(mon, path, t0, wall_clock_s(), clock, &o);
+  fprintf(stderr, "hunting estimate: --state-in %s: %s\n", path, o.text);
+  snprintf(text, len, "%s", o.text);
 }
 
 int cmd_estimate(const cli_args *a) {
@@ -317,7 +381,10 @@ int cmd_estimate(const cli_args *a) {
             n_head == 0 ? "no samples (only a header)" : "fewer than two samples with a finite time stamp");
     rc = 1;
   }
-  run_state run = {NULL, &veh, every, v_const, NAN, -INFINITY, -INFINITY, 0, 0, NULL, {0.0, 0.0}, 0, {0, 0, 0}};
+  run_state run = {NULL, &veh, every, v_const, NAN, -INFINITY, -INFINITY, 0, 0, NULL, {0.0, 0.0}, 0, {0, 0, 0},
+                   NULL, NULL, 0.0, NAN, 0};
+  hm_state_clock clock = HM_STATE_CLOCK_LINE;
+  if (rc == 0) rc = state_options(a, &run, &clock);
   if (rc == 0 && speed_path) {
     rc = cli_csv_open(&spd, speed_path, 2, 1);
     spd_open = rc == 0;
@@ -353,6 +420,13 @@ int cmd_estimate(const cli_args *a) {
       rc = 1;
     }
   }
+  static char restored[HM_STATE_TEXT_MAX];
+  for (size_t i = 0; rc == 0 && cli_value(a, "state-in") && i < n_head; ++i)
+    if (isfinite(head[2 * i])) { /* at the first sample: its time is the restored ages' now */
+      restore_state(cli_value(a, "state-in"), run.mon, head[2 * i], clock, restored, sizeof restored);
+      run.restored = restored;
+      break;
+    }
   for (size_t i = 0; rc == 0 && i < n_head; ++i) rc = process_row(&run, &head[2 * i], ended && i + 1 == n_head);
   double row[2];
   while (rc == 0 && !ended && (r = cli_csv_next(&acc, row)) != 0) rc = r < 0 ? 1 : process_row(&run, row, 0);
@@ -361,8 +435,10 @@ int cmd_estimate(const cli_args *a) {
   if (rc == 0 && isfinite(run.t_last) && (run.t_written < run.t_last || run.since_line > 0 ||
                                           run.counts.speed_rows_unused > 0)) {
     hm_monitor_status st;
-    if (hm_monitor_update(run.mon, run.t_last, &st) == HM_OK) write_line(&st, run.t_last, &run.counts);
+    if (hm_monitor_update(run.mon, run.t_last, &st) == HM_OK) write_line(&st, run.t_last, &run.counts, run.restored);
   }
+  if (rc == 0 && run.state_out && isfinite(run.t_last)) write_state(&run, run.t_last); /* and at the end */
+  if (rc == 0 && run.state_failed) rc = 1;
   /* a run that could use no speed or no acceleration is an error, whatever it printed (every line NO_DATA) */
   hm_monitor_status end;
   if (rc == 0 && run.mon && isfinite(run.t_last) && hm_monitor_update(run.mon, run.t_last, &end) == HM_OK) {

@@ -487,10 +487,18 @@ static const command commands[] = {
      "distribution; null beyond the data. --csv-out writes y_mm,conicity for 'hunting fit-conicity --y-unit mm'.",
      equivalent_conicity_opts, cmd_equivalent_conicity},
     {"estimate", "run the online monitor over recorded acceleration and speed",
-     "--accel FILE.csv (--speed FILE.csv | --v KM/H) [--table FILE] [--monitor FILE] [--every S]",
+     "--accel FILE.csv (--speed FILE.csv | --v KM/H) [--table FILE] [--monitor FILE] [--every S]\n"
+     "                [--state-in FILE] [--state-out FILE] [--state-every S] [--state-clock recording|wall]",
      "Run exactly the online estimator and alarm code over recorded data (CSV t_s,accel_mps2 and t_s,speed_kmh)\n"
      "and print one JSON object per output interval: amplitude, frequency, conicity estimate, margins,\n"
-     "criteria, level and reason.",
+     "criteria, level and reason.\n"
+     "State kept between runs: --state-out writes what the monitor learned (the identification's windows with\n"
+     "their speeds and ages, conicity changes, a held ALARM, hunted-at speeds); --state-in restores it at the first\n"
+     "sample, unless it is for another vehicle or other settings, damaged, of a newer format, or memory_s (900 s)\n"
+     "old or more; the outcome goes to stderr and into the first line (\"restored\": \"restored, age 42 s, 3\n"
+     "windows\" or the reason). Its age is read on the recording's time line (--state-clock recording: right when\n"
+     "both runs read one recording's time line, e.g. its first minute and then the rest, however long apart the\n"
+     "runs were made) or on the wall clock (--state-clock wall).",
      estimate_opts, cmd_estimate},
     {"sweep", "linear critical speed over a conicity range", "[--from L --to L --n COUNT] [--table]",
      "Linear critical speed over a range of equivalent conicities (JSON, or a table with --table).", sweep_opts,

@@ -755,3 +755,53 @@ hm_status hm_alarm_update(hm_alarm a, const hm_estimate *e, const hm_margin_esti
   *out = s;
   return HM_OK;
 }
+
+/* ---- what the alarm holds through a restart (alarm.h's hm_alarm_snapshot; state.h) ---- */
+
+void hm_alarm_take_snapshot(const hm_alarm a, double now, hm_alarm_snapshot *out) {
+  if (!a || !out || !isfinite(now)) return;
+  hm_alarm_snapshot s;
+  memset(&s, 0, sizeof s);
+  s.latched = a->latched;
+  s.latch_reason = a->latched ? a->latch_cause : HM_REASON_STARTUP;
+  /* the hunted-at speed while it counts (hunted_bound): held, on a restarted line, or within memory_s */
+  const int counts = a->hunted_at_kmh < INFINITY &&
+                     (a->latched || isnan(a->hunted_t_s) || now - a->hunted_t_s <= a->memory_s);
+  s.hunted_at_kmh = counts ? a->hunted_at_kmh : INFINITY;
+  s.hunted_age_s = counts && !isnan(a->hunted_t_s) ? fmax(now - a->hunted_t_s, 0.0) : counts ? NAN : 0.0;
+  s.precise = a->precise;
+  *out = s;
+}
+
+hm_status hm_alarm_snapshot_validate(const hm_alarm_snapshot *s, char *why, size_t len) {
+  if (!s) return HM_EINVAL;
+  const char *field = NULL;
+  if (s->latched != 0 && s->latched != 1) field = "latched: 0 or 1";
+  else if (s->latched && !oscillation_reason(s->latch_reason))
+    field = "latch_reason: an oscillation's (r.m.s., peaks, displacement, beyond the unstable cycle)";
+  else if (!(s->hunted_at_kmh > 0.0 && s->hunted_at_kmh <= 2000.0) && s->hunted_at_kmh != INFINITY)
+    field = "hunted_at_kmh: in (0, 2000] or INFINITY";
+  else if (s->hunted_at_kmh != INFINITY && !isnan(s->hunted_age_s) &&
+           !(isfinite(s->hunted_age_s) && s->hunted_age_s >= 0.0))
+    field = "hunted_age_s: finite and >= 0, or NAN";
+  else if (s->precise != 0 && s->precise != 1) field = "precise: 0 or 1";
+  if (!field) return HM_OK;
+  if (why && len) snprintf(why, len, "alarm: %s", field);
+  return HM_EDOMAIN;
+}
+
+hm_status hm_alarm_restore(hm_alarm a, double now, const hm_alarm_snapshot *s, char *why, size_t len) {
+  if (!a || !s || !isfinite(now)) return HM_EINVAL;
+  const hm_status st = hm_alarm_snapshot_validate(s, why, len);
+  if (st != HM_OK) return st;
+  hm_alarm_reset(a);
+  a->latched = s->latched;
+  if (a->latched) { /* its times, like a restarted time line's, are unknown (NAN): the hold says so (alarm.h) */
+    a->latch_cause = s->latch_reason, a->level = HM_LEVEL_ALARM, a->reason = s->latch_reason;
+    a->latch_since_s = a->latch_last_met_s = NAN;
+  }
+  a->hunted_at_kmh = s->hunted_at_kmh;
+  a->hunted_t_s = s->hunted_at_kmh < INFINITY && !isnan(s->hunted_age_s) ? now - s->hunted_age_s : NAN;
+  a->precise = s->precise;
+  return HM_OK;
+}

@@ -575,3 +575,106 @@ void hm_margin_read(const hm_margin m, double now, hm_margin_estimate *out) {
                      r.n_misfits >= 2;
   *out = r;
 }
+
+/* ---- what the margin has learned, kept through a restart (margin.h's hm_margin_snapshot; state.h) ---- */
+
+void hm_margin_take_snapshot(const hm_margin m, double now, hm_margin_snapshot *out) {
+  if (!m || !out || !isfinite(now)) return;
+  hm_margin_snapshot s;
+  memset(&s, 0, sizeof s);
+  const window *ws[HM_MARGIN_MAX_WINDOWS + 1];
+  size_t n = held(m, now, ws); /* newest first */
+  if (m->have_pending) { /* committed, as a gap would commit it; the oldest goes where the ring is full */
+    memmove(ws + 1, ws, n * sizeof ws[0]);
+    ws[0] = &m->pending;
+    n = n < HM_MARGIN_MAX_WINDOWS ? n + 1 : HM_MARGIN_MAX_WINDOWS;
+  }
+  for (size_t k = 0; k < n; ++k) {
+    const window *w = ws[n - 1 - k];
+    hm_margin_window *o = &s.windows[k];
+    o->age_s = fmax(now - w->t_end_s, 0.0);
+    o->speed_kmh = w->speed_kmh;
+    o->window_s = w->window_s;
+    o->sigma_1_s = w->sigma;
+    o->sigma_stat_1_s = w->sigma_stat;
+    o->conicity = w->lambda;
+    o->conicity_se = w->lambda_se;
+    o->conicity_stat = w->lambda_stat;
+    o->conicity_sys = w->lambda_sys;
+  }
+  s.n_windows = (unsigned)n;
+  for (size_t k = 0; k < m->misfit_n; ++k)
+    if (now - m->misfit_t[k] <= m->cfg.memory_s) s.misfit_age_s[s.n_misfits++] = fmax(now - m->misfit_t[k], 0.0);
+  if (m->pending_misfit && s.n_misfits < HM_MARGIN_MAX_WINDOWS)
+    s.misfit_age_s[s.n_misfits++] = fmax(now - m->pending_misfit_t, 0.0);
+  s.n_changes = m->n_changes;
+  s.last_change_age_s = m->n_changes ? fmax(now - m->last_change_s, 0.0) : 0.0;
+  s.windows_since_change = (unsigned)(m->since_change + (size_t)m->have_pending);
+  s.narrow = m->narrow;
+  s.narrow_peak_hz = m->narrow_hz;
+  s.narrow_age_s = m->narrow_at_s != 0.0 ? fmax(now - m->narrow_at_s, 0.0) : INFINITY;
+  s.ambiguous_age_s = m->ambiguous_at_s > 0.0 ? fmax(now - m->ambiguous_at_s, 0.0) : INFINITY;
+  *out = s;
+}
+
+/* x in [lo, hi] (NaN is not) */
+static int in_range(double x, double lo, double hi) { return x >= lo && x <= hi; }
+
+/* What is wrong with a kept window, or NULL. */
+static const char *window_fault(const hm_margin_window *w) {
+  if (!(isfinite(w->age_s) && w->age_s >= 0.0)) return "age_s: finite and >= 0";
+  if (!(w->speed_kmh > 0.0 && w->speed_kmh <= 2000.0)) return "speed_kmh: in (0, 2000]";
+  if (!(w->window_s > 0.0 && w->window_s <= 3600.0)) return "window_s: in (0, 3600]";
+  if (!in_range(w->sigma_1_s, -1e4, 0.0)) return "sigma_1_s: in [-1e4, 0]";
+  if (!in_range(w->sigma_stat_1_s, 1e-12, 1e4)) return "sigma_stat_1_s: in [1e-12, 1e4]";
+  if (!(w->conicity > 0.0 && w->conicity <= 100.0)) return "conicity: in (0, 100]";
+  if (!in_range(w->conicity_se, 1e-12, 100.0)) return "conicity_se: in [1e-12, 100]";
+  if (!in_range(w->conicity_stat, 0.0, 100.0) || !in_range(w->conicity_sys, 0.0, 100.0))
+    return "conicity_stat, conicity_sys: in [0, 100]";
+  return NULL;
+}
+
+hm_status hm_margin_snapshot_validate(const hm_margin_snapshot *s, char *why, size_t len) {
+  if (!s) return HM_EINVAL;
+  const char *field = NULL;
+  char where[48] = "";
+  if (s->n_windows > HM_MARGIN_MAX_WINDOWS) field = "n_windows: at most 64";
+  for (unsigned k = 0; !field && k < s->n_windows; ++k)
+    if ((field = window_fault(&s->windows[k])) != NULL) snprintf(where, sizeof where, "window %u ", k);
+  if (!field && s->n_misfits > HM_MARGIN_MAX_WINDOWS) field = "n_misfits: at most 64";
+  for (unsigned k = 0; !field && k < s->n_misfits; ++k)
+    if (!(isfinite(s->misfit_age_s[k]) && s->misfit_age_s[k] >= 0.0)) field = "misfit_age_s: finite and >= 0";
+  if (!field && s->n_changes && !(isfinite(s->last_change_age_s) && s->last_change_age_s >= 0.0))
+    field = "last_change_age_s: finite and >= 0";
+  if (!field && !((unsigned)s->narrow <= HM_NARROW_AMBIGUOUS)) field = "narrow: a narrow-peak verdict (0..3)";
+  if (!field && !in_range(s->narrow_peak_hz, 0.0, 1e4)) field = "narrow_peak_hz: in [0, 1e4]";
+  if (!field && !(s->narrow_age_s >= 0.0 && s->ambiguous_age_s >= 0.0))
+    field = "narrow_age_s, ambiguous_age_s: >= 0 (INFINITY: none)";
+  if (!field) return HM_OK;
+  if (why && len) snprintf(why, len, "margin: %s%s", where, field);
+  return HM_EDOMAIN;
+}
+
+hm_status hm_margin_restore(hm_margin m, double now, const hm_margin_snapshot *s, char *why, size_t len) {
+  if (!m || !s || !isfinite(now)) return HM_EINVAL;
+  const hm_status st = hm_margin_snapshot_validate(s, why, len);
+  if (st != HM_OK) return st;
+  hm_margin_reset(m);
+  for (unsigned k = 0; k < s->n_windows; ++k) {
+    const hm_margin_window *o = &s->windows[k];
+    const window w = {now - o->age_s, o->speed_kmh, o->window_s, o->sigma_1_s, o->sigma_stat_1_s,
+                      o->conicity, o->conicity_se, o->conicity_stat, o->conicity_sys};
+    store(m, &w);
+  }
+  for (unsigned k = 0; k < s->n_misfits; ++k) misfit_push(m, now - s->misfit_age_s[k]);
+  m->n_changes = s->n_changes;
+  m->last_change_s = s->n_changes ? now - s->last_change_age_s : 0.0;
+  m->since_change = s->windows_since_change;
+  m->narrow = s->narrow;
+  m->narrow_hz = s->narrow_peak_hz;
+  m->narrow_at_s = isfinite(s->narrow_age_s) ? now - s->narrow_age_s : 0.0;
+  /* 0 means none here: an ambiguous peak from before the new line's zero is kept at its smallest positive time (its
+   * WATCH then lasts at most that much longer) */
+  if (isfinite(s->ambiguous_age_s)) m->ambiguous_at_s = fmax(now - s->ambiguous_age_s, nextafter(0.0, 1.0));
+  return HM_OK;
+}

@@ -413,3 +413,27 @@ hm_status hm_monitor_replace_table(hm_monitor m, hm_table table, hm_table *repla
   m->table = table;
   return HM_OK;
 }
+
+void hm_monitor_vehicle(const hm_monitor m, hm_vehicle *veh) {
+  if (m && veh) *veh = m->veh;
+}
+
+void hm_monitor_take_snapshot(const hm_monitor m, double now_s, hm_monitor_snapshot *out) {
+  if (!m || !out || !isfinite(now_s)) return;
+  hm_monitor_snapshot s;
+  hm_margin_take_snapshot(m->margin, now_s, &s.margin);
+  hm_alarm_take_snapshot(m->alarm, now_s, &s.alarm);
+  *out = s;
+}
+
+hm_status hm_monitor_restore(hm_monitor m, double now_s, const hm_monitor_snapshot *snap, char *why, size_t len) {
+  if (!m || !snap || !isfinite(now_s)) return HM_EINVAL;
+  hm_status st = hm_margin_snapshot_validate(&snap->margin, why, len);
+  if (st == HM_OK) st = hm_alarm_snapshot_validate(&snap->alarm, why, len);
+  if (st != HM_OK) return st;
+  restart_input(m);
+  m->large_at = -INFINITY;
+  /* both were validated above, so neither can fail half-way */
+  if ((st = hm_margin_restore(m->margin, now_s, &snap->margin, why, len)) != HM_OK) return st;
+  return hm_alarm_restore(m->alarm, now_s, &snap->alarm, why, len);
+}

@@ -5,8 +5,11 @@
 #include <std_msgs/UInt8.h>
 #include <visualization_msgs/MarkerArray.h>
 
+#include <sys/stat.h>
+
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
 
 #include "yaml_params.h"
 
@@ -28,6 +31,20 @@ std::string reasonText(const hm_assessment& s) {
   char text[512];
   hm_assessment_reason_text(&s, NAN, text, sizeof text);  // times as ages: the sensor's line is no clock to read
   return text;
+}
+
+// The state file's default: $ROS_HOME (or ~/.ros)/hunting_monitor_state/<the node's namespace, '/' as '.'>, the
+// directories made if missing (each monitor its own file: a node and a nodelet on one machine do not share one).
+std::string defaultStateFile(const std::string& ns) {
+  const char* ros_home = std::getenv("ROS_HOME");
+  const char* home = std::getenv("HOME");
+  const std::string dir = ros_home && *ros_home ? ros_home : std::string(home && *home ? home : ".") + "/.ros";
+  std::string name = ns.substr(ns.find_first_not_of('/') == std::string::npos ? ns.size() : ns.find_first_not_of('/'));
+  for (char& ch : name)
+    if (ch == '/') ch = '.';
+  ::mkdir(dir.c_str(), 0755);
+  ::mkdir((dir + "/hunting_monitor_state").c_str(), 0755);
+  return dir + "/hunting_monitor_state/" + (name.empty() ? "hunting_monitor" : name);
 }
 }  // namespace
 
@@ -56,6 +73,7 @@ MonitorRos::MonitorRos(ros::NodeHandle nh, ros::NodeHandle pnh)
   updater_.add("hunting level", this, &MonitorRos::diagnoseLevel);
   updater_.add("boundary table", this, &MonitorRos::diagnoseTable);
   updater_.add("settings", this, &MonitorRos::diagnoseSettings);
+  updater_.add("state file", this, &MonitorRos::diagnoseState);
   if (allow_reconfigure_) {
     reconfigure_.reset(new SettingsReconfigure(pnh_, monitor_));
     ROS_WARN("hunting_monitor: ~allow_reconfigure: the alarm and criteria settings can be changed through "
@@ -66,6 +84,11 @@ MonitorRos::MonitorRos(ros::NodeHandle nh, ros::NodeHandle pnh)
   ROS_INFO("hunting_monitor: ready (accel %s at %.0f Hz stamped by %s time, speed in %s, status at %.1f Hz, table %s)",
            accel_type_.c_str(), cfg_.estimator.sample_rate_hz, time_source_.c_str(), speed_unit_.c_str(), status_rate_hz_,
            table_file_.c_str());
+  if (state_file_.empty())
+    ROS_INFO("hunting_monitor: ~state_file empty: what the monitor learns is not kept through a restart");
+  else
+    ROS_INFO("hunting_monitor: state file %s (restored with the first sample, written every %.1f s and at shutdown)",
+             state_file_.c_str(), state_period_s_);
 }
 
 MonitorRos::~MonitorRos() {
@@ -76,6 +99,10 @@ MonitorRos::~MonitorRos() {
   speed_sub_.shutdown();
   reconfigure_.reset();
   refiner_.reset();  // joins the worker, which may be reading the monitor's table
+  if (monitor_ && !state_file_.empty() && !state_restore_pending_ && have_update_) {
+    saveState(last_line_s_, last_wall_s_);  // at shutdown: what the last update knew
+    ROS_INFO_COND(state_write_error_.empty(), "hunting_monitor: state written to %s", state_file_.c_str());
+  }
   hm_monitor_destroy(monitor_);
 }
 
@@ -103,6 +130,17 @@ bool MonitorRos::loadParameters() {
   pnh_.param("status_rate_hz", status_rate_hz_, 20.0);
   pnh_.param("bench_table_churn", bench_table_churn_, false);
   pnh_.param("allow_reconfigure", allow_reconfigure_, false);
+  hm_state_config state_cfg;
+  hm_state_config_default(&state_cfg);
+  pnh_.param("state_period_s", state_cfg.period_s, state_cfg.period_s);
+  if (hm_state_config_validate(&state_cfg, err, sizeof err) != HM_OK) {
+    ROS_FATAL("hunting_monitor: ~state_period_s: %s", err);
+    return false;
+  }
+  state_period_s_ = state_cfg.period_s;
+  if (!pnh_.getParam("state_file", state_file_)) state_file_ = defaultStateFile(pnh_.getNamespace());
+  state_restore_pending_ = !state_file_.empty();
+  state_outcome_ = state_file_.empty() ? "off (~state_file empty)" : "waiting for the first sample to restore";
   hm_clock_config clock_cfg;
   hm_clock_config_default(&clock_cfg);
   pnh_.param("clock/window_s", clock_cfg.window_s, clock_cfg.window_s);
@@ -297,11 +335,21 @@ void MonitorRos::onSpeed(const std_msgs::Float64::ConstPtr& msg) {
 void MonitorRos::onTimer(const ros::TimerEvent&) {
   const ros::Time now = ros::Time::now();
   checkRosTime(now);
+  // the state is restored on a known time line: the sensor's, from its first stamped sample (receipt time: ROS time)
+  if (state_restore_pending_ && !now.isZero() && (!header_time_ || clock_.have_offset)) restoreState(now);
   hm_monitor_status st;
-  const hm_status ust = hm_monitor_update(monitor_, lineTime(now), &st);
+  const double line_s = lineTime(now), wall_s = ros::WallTime::now().toSec();
+  const hm_status ust = hm_monitor_update(monitor_, line_s, &st);
   if (ust != HM_OK) {
     publishFailure(ust, now);
     return;
+  }
+  last_line_s_ = line_s;
+  last_wall_s_ = wall_s;
+  have_update_ = true;
+  if (!state_file_.empty() && !state_restore_pending_ && wall_s >= next_state_write_) {
+    saveState(line_s, wall_s);
+    next_state_write_ = wall_s + state_period_s_;
   }
   refineTable();
   last_ = st;
@@ -661,6 +709,57 @@ void MonitorRos::diagnoseTable(diagnostic_updater::DiagnosticStatusWrapper& stat
     stat.add("last exact family took [ms]", 1e3 * last_refine_s_);
   }
   if (refinement_failures_ > 0) stat.add("last failure", last_refine_error_);
+}
+
+void MonitorRos::restoreState(const ros::Time& now) {
+  state_restore_pending_ = false;
+  hm_state_outcome o;
+  const double wall_s = ros::WallTime::now().toSec();
+  const hm_status st =
+      hm_state_restore_file(monitor_, state_file_.c_str(), lineTime(now), wall_s, HM_STATE_CLOCK_WALL, &o);
+  state_outcome_ = o.text;
+  state_verdict_ = static_cast<int>(o.verdict);
+  state_from_prev_ = o.from_prev != 0;
+  if (st == HM_OK || o.verdict == HM_STATE_NO_FILE)
+    ROS_INFO("hunting_monitor: state file %s: %s", state_file_.c_str(), o.text);
+  else
+    ROS_WARN("hunting_monitor: state file %s: %s (starting from the prior)", state_file_.c_str(), o.text);
+  next_state_write_ = wall_s + state_period_s_;
+  updater_.force_update();
+}
+
+void MonitorRos::saveState(double line_s, double wall_s) {
+  char why[512] = "";
+  const ros::WallTime t0 = ros::WallTime::now();
+  if (hm_state_save_file(monitor_, state_file_.c_str(), line_s, wall_s, why, sizeof why) == HM_OK) {
+    ++state_writes_;
+    state_write_error_.clear();
+  } else {
+    ++state_write_failures_;
+    state_write_error_ = why;
+    ROS_ERROR_THROTTLE(10.0, "hunting_monitor: the state could not be written: %s", why);
+  }
+  state_write_ms_ = 1e3 * (ros::WallTime::now() - t0).toSec();
+}
+
+void MonitorRos::diagnoseState(diagnostic_updater::DiagnosticStatusWrapper& stat) {
+  using diagnostic_msgs::DiagnosticStatus;
+  // refused, or restored from FILE.prev (FILE was refused): WARN
+  const bool refused = (state_verdict_ > static_cast<int>(HM_STATE_RESTORED) &&
+                        state_verdict_ != static_cast<int>(HM_STATE_NO_FILE)) ||
+                       state_from_prev_;
+  if (!state_write_error_.empty())
+    stat.summary(DiagnosticStatus::ERROR, "the state could not be written: " + state_write_error_);
+  else if (state_verdict_ == static_cast<int>(HM_STATE_NO_FILE))
+    stat.summary(DiagnosticStatus::OK, "no state file yet (a first start): " + state_outcome_);
+  else
+    stat.summary(refused ? DiagnosticStatus::WARN : DiagnosticStatus::OK, state_outcome_);
+  stat.add("file", state_file_.empty() ? std::string("(off)") : state_file_);
+  stat.add("restore", state_outcome_);
+  stat.add("written every [s]", state_period_s_);
+  stat.add("writes", state_writes_);
+  stat.add("write failures", state_write_failures_);
+  stat.add("last write took [ms]", state_write_ms_);
 }
 
 void MonitorRos::diagnoseSettings(diagnostic_updater::DiagnosticStatusWrapper& stat) {

@@ -20,6 +20,7 @@ extern "C" {
 #include "hunting_monitor/clock.h"
 #include "hunting_monitor/model.h"
 #include "hunting_monitor/monitor.h"
+#include "hunting_monitor/state.h"
 }
 
 namespace hunting_monitor {
@@ -59,6 +60,12 @@ class MonitorRos {
   void diagnoseLevel(diagnostic_updater::DiagnosticStatusWrapper& stat);
   void diagnoseTable(diagnostic_updater::DiagnosticStatusWrapper& stat);
   void diagnoseSettings(diagnostic_updater::DiagnosticStatusWrapper& stat);
+  // The state file (state.h: what the monitor learned, kept through a restart): restored once the time line is
+  // known (the first stamped sample, or with receipt time the first ROS time), its age on the wall clock; written
+  // every ~state_period_s of wall time and at shutdown.
+  void restoreState(const ros::Time& now);
+  void saveState(double line_s, double wall_s);
+  void diagnoseState(diagnostic_updater::DiagnosticStatusWrapper& stat);
 
   ros::NodeHandle nh_, pnh_;
   bool ok_ = false;
@@ -68,6 +75,8 @@ class MonitorRos {
   bool header_time_ = true;       // ~time_source: Imu header stamps (true) or receipt time
   double status_rate_hz_ = 20.0;
   bool allow_reconfigure_ = false;  // ~allow_reconfigure: offer the alarm and criteria settings to dynamic_reconfigure
+  std::string state_file_;          // ~state_file ("" disables; unset: under ROS_HOME, named after the node)
+  double state_period_s_ = 2.0;     // ~state_period_s (wall time)
   hm_vehicle vehicle_{};
   hm_monitor_config cfg_{};
   // the core's monitor (estimator, identification, margin, alarm, table)
@@ -93,6 +102,17 @@ class MonitorRos {
   unsigned long time_jumps_ = 0;
   std::string last_jump_;
   double last_jump_at_ = -1e300;
+  // the state file
+  bool state_restore_pending_ = false;  // enabled and not restored yet (nothing is written before)
+  std::string state_outcome_;           // what the restore did (hm_state_outcome's text)
+  int state_verdict_ = -1;              // its hm_state_verdict (-1 before)
+  bool state_from_prev_ = false;        // restored from FILE.prev: FILE was missing or refused
+  double next_state_write_ = 0.0;       // wall time of the next write
+  double last_line_s_ = 0.0, last_wall_s_ = 0.0;  // the last update's time (sensor line) and wall time
+  bool have_update_ = false;
+  unsigned long state_writes_ = 0, state_write_failures_ = 0;
+  std::string state_write_error_;       // the last write's failure ("" after a success)
+  double state_write_ms_ = 0.0;         // how long the last write took (fsync included)
   // ROS
   ros::Subscriber accel_sub_, speed_sub_;
   ros::Publisher status_pub_, alarm_pub_, alarm_stamped_pub_, marker_pub_, chart_pub_;

@@ -9,8 +9,10 @@ import json
 import math
 import os
 import subprocess
+import struct
 import sys
 import tempfile
+import zlib
 
 HUNTING = sys.argv[1]
 SRC = sys.argv[2]
@@ -521,6 +523,97 @@ def test_estimate_last_line_counts_everything():
         assert last["level"] != "NO_DATA" and last["speed_valid"], last
         for key in ("gaps", "samples_lost", "rate_changes"):
             assert last[key] == 0, (key, last[key])
+
+
+def split_recording(path, t_split, first, second, shift=0.0):
+    """The rows of a t_s,... CSV before t_split into first, the others (their times + shift) into second."""
+    with open(path) as f:
+        head = next(f)
+        with open(first, "w") as a, open(second, "w") as b:
+            a.write(head)
+            b.write(head)
+            for line in f:
+                t, rest = line.split(",", 1)
+                if float(t) < t_split:
+                    a.write(line)
+                else:
+                    b.write(f"{float(t) + shift!r},{rest}")
+
+
+def test_estimate_state_survives_a_restart():
+    # 120 s at 480 km/h (35 km/h below the Hopf speed, 517.6 km/h) on 10% of the low-disturbance track: the prior's
+    # interval, 464.8-593.8 km/h, gives WARN at 480 km/h until the first full window (40 s) identifies the conicity.
+    # The recording's first minute, run alone with --state-out, writes the state; the second minute, run with
+    # --state-in, starts where the whole run is at 60 s: its first status has the identified interval of the whole
+    # run at 60 s, and no line is a WARN from the prior. The file is the format state.h documents (its CRC-32 checked
+    # with zlib's). Without the state the second minute starts from the prior (WARN); a foreign vehicle's state, a
+    # stale one (the second minute 1000 s later on the same time line: memory_s is 900 s) and a damaged one are
+    # refused with their reasons, the last restored from FILE.prev.
+    with tempfile.TemporaryDirectory() as d:
+        p = {n: os.path.join(d, n) for n in ("a.csv", "s.csv", "a1.csv", "s1.csv", "a2.csv", "s2.csv", "a3.csv",
+                                              "s3.csv", "state")}
+        run("simulate", "--v", "480", "--t", "120", "--irregularity", "0.1", "--dt-out", "0.0005", "--accel-out",
+            p["a.csv"], "--speed-out", p["s.csv"], "--accel-noise", "0.05", "--out", os.devnull)
+        for name in ("a", "s"):
+            split_recording(p[f"{name}.csv"], 60.0, p[f"{name}1.csv"], p[f"{name}2.csv"])
+            split_recording(p[f"{name}.csv"], 60.0, os.devnull, p[f"{name}3.csv"], shift=1000.0)
+        table = shipped_table()
+
+        def part(k, *extra):
+            r = run("estimate", "--accel", p[f"a{k}.csv"], "--speed", p[f"s{k}.csv"], "--table", table, "--every",
+                    "1", *extra)
+            return lines(r.stdout), r.stderr
+        whole = lines(run("estimate", "--accel", p["a.csv"], "--speed", p["s.csv"], "--table", table, "--every",
+                          "1").stdout)
+        at60 = [o for o in whole if o["t_s"] <= 60.0][-1]
+        assert at60["conicity_from_estimate"] and at60["level"] != "WARN", at60
+        assert at60["hopf_kmh_low"] <= 517.618 <= at60["hopf_kmh_high"], at60
+        first, _ = part(1, "--state-out", p["state"])
+        assert all("restored" not in o for o in first), first[0]
+        with open(p["state"], "rb") as f:
+            rec = f.read()
+        version, length = struct.unpack("<II", rec[8:16])
+        assert rec[:8] == b"HMSTATE\0" and version == 1 and length == len(rec) == 128 + 72 * at60["windows_used"], \
+            (rec[:16], len(rec))
+        assert struct.unpack("<I", rec[-4:])[0] == zlib.crc32(rec[:-4]), "CRC-32"
+        assert os.path.exists(p["state"] + ".prev"), "the previous state is kept"
+        second, err = part(2, "--state-in", p["state"])
+        said = f"restored, age 0 s, {at60['windows_used']} window"
+        assert said in err and second[0]["restored"].startswith(said), (err, second[0].get("restored"))
+        o = second[0]
+        assert o["conicity_from_estimate"] and o["level"] == at60["level"], o
+        for key in ("hopf_kmh_low", "hopf_kmh_high", "hopf_kmh", "conicity_used", "warn_from_kmh"):
+            close(o[key], at60[key], 1e-9 * abs(at60[key]), f"restored {key}")
+        assert not any(o["level"] == "WARN" and o["conicity_from_prior"] for o in second), \
+            [(o["t_s"], o["level"]) for o in second if o["level"] == "WARN"]
+        assert all("restored" not in o for o in second[1:]), "only the first line says it"
+        # the control: the second minute alone starts from the prior
+        fresh, _ = part(2)
+        assert fresh[0]["level"] == "WARN" and fresh[0]["conicity_from_prior"], fresh[0]
+        # refused: another vehicle (lambda(0) 0.15), too old (the same time line 1000 s later), then damaged
+        for k, extra, reason in ((2, ("--conicity", "0.15"), "written for another vehicle or other settings"),
+                                 (3, (), "too old: age 1000 s on the time line, the margin's memory_s 900 s")):
+            out, err = part(k, "--state-in", p["state"], *extra)
+            assert reason in err and out[0]["restored"].startswith("not restored: ") and reason in out[0]["restored"], \
+                (err, out[0].get("restored"))
+            assert out[0]["level"] == "WARN" and out[0]["conicity_from_prior"], out[0]
+        with open(p["state"], "wb") as f:
+            f.write(rec[:100])
+        out, err = part(2, "--state-in", p["state"])
+        assert f"{p['state']}: truncated: 100 of {len(rec)} bytes" in err and "restored from " in err, err
+        assert out[0]["conicity_from_estimate"], out[0]
+        # the wall clock: run right after, the state is seconds old
+        out, err = part(2, "--state-in", p["state"] + ".prev", "--state-clock", "wall")
+        assert out[0]["restored"].startswith("restored, age ") and out[0]["conicity_from_estimate"], out[0]
+        p_bad = run("estimate", "--accel", p["a2.csv"], "--speed", p["s2.csv"], "--table", table, "--state-every", "0",
+                    ok=False)
+        assert p_bad.returncode == 1 and "--state-every: state.period_s: must be in [0.1, 3600]" in p_bad.stderr
+        p_bad = run("estimate", "--accel", p["a2.csv"], "--speed", p["s2.csv"], "--table", table, "--state-out",
+                    os.path.join(d, "no", "such", "dir"), ok=False)
+        assert p_bad.returncode == 1 and "--state-out: " in p_bad.stderr and "cannot create" in p_bad.stderr
+    print(f"  state: at 60 s the whole run and the restored one [{at60['hopf_kmh_low']:.2f}, "
+          f"{at60['hopf_kmh_high']:.2f}] ({at60['level']}), the fresh one {fresh[0]['level']} "
+          f"[{fresh[0]['hopf_kmh_low']:.2f}, {fresh[0]['hopf_kmh_high']:.2f}]")
 
 
 def test_estimate_streams_long_recordings():

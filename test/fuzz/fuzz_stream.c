@@ -5,6 +5,7 @@
 #include <stdint.h>
 #include <string.h>
 
+#include "fuzz_monitor.h"
 #include "hunting_monitor/monitor.h"
 
 static hm_monitor monitor;
@@ -23,12 +24,7 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size) {
     hm_monitor_config_default(&c);
     c.modal.min_window_s = 2.0; /* fits early: they are what the fuzzer should reach */
     c.modal.window_s = 5.0;
-    hm_vehicle v;
-    hm_vehicle_default(&v);
-    hm_table t = NULL;
-    if (hm_table_load_file(HM_SOURCE_DIR "/config/crh380_default.tbl", &t, NULL, 0) != HM_OK ||
-        hm_monitor_create(&c, &v, t, &monitor, NULL, 0) != HM_OK)
-      __builtin_trap();
+    monitor = fuzz_monitor_create(&c);
   }
   hm_monitor_reset(monitor);
   double t = 0.0;

@@ -2,6 +2,8 @@
 """The node stays up and reports bad input (NaN, out-of-order stamps, silence) and exits with a clear message on
 bad parameters; its settings change through dynamic_reconfigure only when allowed, validated by the core."""
 import math
+import os
+import signal
 import subprocess
 import threading
 import time
@@ -258,6 +260,7 @@ class Robustness(unittest.TestCase):
             ("bad_key", [("vehicle", "mas_kg", 1)], [], "vehicle.mas_kg: unknown key"),
             ("bad_time", [], ["_time_source:=gps"], "~time_source must be header or receipt"),
             ("bad_clock", [], ["_clock/window_s:=-1"], "~clock.window_s: must be in (0, 3600]"),
+            ("bad_state", [], ["_state_period_s:=0"], "~state_period_s: state.period_s: must be in [0.1, 3600]"),
         ]
         for name, changes, extra, message in cases:
             code, out = self.run_bad_node(name, changes, extra)
@@ -333,6 +336,153 @@ class Robustness(unittest.TestCase):
             self.assertAlmostEqual(released.header.stamp.to_sec() - below.header.stamp.to_sec(), 10.0, delta=0.5)
         finally:
             sub.unregister()
+
+    def test_7_restart_keeps_what_was_learned(self):
+        """A monitor at 480 km/h (the simulator, 35 km/h below the Hopf speed) identifies the conicity; killed (SIGKILL:
+        only its periodic state file survives) and started again, its first status with data has the interval it had
+        before (exactly, that of its status when it last wrote the file: one in its last state_period_s + 1 s) and the
+        same level, the diagnostics say
+        "restored, age ...". Stopped (SIGINT: it writes at shutdown), its file truncated: the next start refuses it
+        and restores the previous one (FILE.prev). The first start, with no file, is the control: the prior."""
+        with open(rospy.get_param("~vehicle_config")) as f:
+            params = yaml.safe_load(f)
+        for section, value in params.items():
+            rospy.set_param(f"/restart_monitor/{section}", value)
+            rospy.set_param(f"/restart_sim/{section}", value)
+        rospy.set_param("/restart_monitor/table_file", rospy.get_param("~table"))
+        for key, value in (("v_start_kmh", 480.0), ("v_end_kmh", 480.0), ("ramp_s", 0.0), ("hold_s", 240.0),
+                           ("irregularity_scale", 0.1), ("seed", 7)):
+            rospy.set_param(f"/restart_sim/{key}", value)
+        # the node's default file (under ROS_HOME, named after it); a leftover of an earlier run removed
+        home = os.environ.get("ROS_HOME") or os.path.join(os.path.expanduser("~"), ".ros")
+        path = os.path.join(home, "hunting_monitor_state", "restart_monitor")
+        for p in (path, path + ".prev"):
+            if os.path.exists(p):
+                os.remove(p)
+        topics = ["accel:=/restart/accel", "speed:=/restart/speed"]
+        outputs = [f"{t}:=/restart/{t}" for t in ("hunting_status", "hunting_alarm", "hunting_alarm_stamped",
+                                                  "hunting_markers", "hunting_chart")]
+        node = roslib.packages.find_node("hunting_monitor", "hunting_monitor_node")[0]
+        sim = roslib.packages.find_node("hunting_monitor", "hunting_sim_node")[0]
+        got, diag = [], []
+        lock = threading.Lock()
+
+        def keep(store):
+            def cb(msg):
+                with lock:
+                    store.append((time.time(), msg))
+            return cb
+        subs = [rospy.Subscriber("/restart/hunting_status", HuntingStatus, keep(got), queue_size=1000),
+                rospy.Subscriber("/diagnostics", DiagnosticArray, keep(diag), queue_size=100)]
+
+        def start():
+            return subprocess.Popen([node, "__name:=restart_monitor"] + topics + outputs, stdout=subprocess.DEVNULL,
+                                    stderr=subprocess.DEVNULL)
+
+        def since(t0, store=got):
+            with lock:
+                return [m for t, m in store if t >= t0]
+
+        def state_diag(t0):
+            hits = [s for a in since(t0, diag) for s in a.status if s.name == "restart_monitor: state file"]
+            return hits[-1] if hits else None
+
+        def first_valid(t0, timeout):
+            end = time.time() + timeout
+            while time.time() < end:
+                valid = [m for m in since(t0) if m.boundaries_valid]
+                if valid:
+                    return valid[0]
+                time.sleep(0.1)
+            return None
+
+        def wait_for(cond, timeout):
+            end = time.time() + timeout
+            while time.time() < end and not cond():
+                time.sleep(0.2)
+            return cond()
+        procs = [subprocess.Popen([sim, "__name:=restart_sim"] + topics, stdout=subprocess.DEVNULL,
+                                  stderr=subprocess.DEVNULL)]
+        try:
+            t_a = time.time()
+            a = start()
+            procs.append(a)
+            fresh = first_valid(t_a, 30.0)
+            self.assertIsNotNone(fresh, "no status with data from the first start")
+            self.assertTrue(fresh.conicity_from_prior and fresh.level == HuntingStatus.LEVEL_WARN,
+                            (fresh.level, fresh.reason, fresh.hopf_speed_kmh_low))  # the control: the prior
+            self.assertTrue(wait_for(lambda: state_diag(t_a) is not None and
+                                     state_diag(t_a).message.startswith("no state file yet"), 10.0),
+                            state_diag(t_a) and state_diag(t_a).message)
+            self.assertTrue(wait_for(lambda: any(m.conicity_from_estimate for m in since(t_a)), 70.0),
+                            "the first start did not identify the conicity")
+            t_identified = time.time() - t_a
+
+            def settled():  # the last 5 s identified at one level (the level lowered from the prior's WARN after its
+                # min_hold_s), and a periodic write since
+                recent = [m for m in since(time.time() - 5.0) if m.boundaries_valid]
+                return time.time() - t_a > t_identified + 5.0 and len(recent) > 50 and \
+                    all(m.conicity_from_estimate and m.level == recent[-1].level for m in recent)
+            self.assertTrue(wait_for(settled, 30.0), "the level did not settle")
+            t_kill = time.time()
+            a.kill()  # SIGKILL at speed: no shutdown write
+            a.wait(timeout=10)
+            before = [m for m in since(t_kill - 3.0) if m.boundaries_valid]
+            self.assertTrue(before and all(m.conicity_from_estimate for m in before), "not identified before the kill")
+            t_b = time.time()
+            b = start()
+            procs.append(b)
+            first = first_valid(t_b, 30.0)
+            self.assertIsNotNone(first, "no status with data after the restart")
+            n_before_first = len([m for m in since(t_b) if m.header.stamp < first.header.stamp])
+            self.assertTrue(first.conicity_from_estimate, (first.level, first.reason, first.hopf_speed_kmh_low))
+            self.assertEqual(first.level, before[-1].level, (first.reason, before[-1].reason))
+            match = min(before, key=lambda m: abs(m.hopf_speed_kmh_low - first.hopf_speed_kmh_low) +
+                        abs(m.hopf_speed_kmh_high - first.hopf_speed_kmh_high))
+            self.assertAlmostEqual(first.hopf_speed_kmh_low, match.hopf_speed_kmh_low, delta=1e-6)
+            self.assertAlmostEqual(first.hopf_speed_kmh_high, match.hopf_speed_kmh_high, delta=1e-6)
+            self.assertTrue(wait_for(lambda: state_diag(t_b) is not None and
+                                     state_diag(t_b).message.startswith("restored, age "), 10.0),
+                            state_diag(t_b) and state_diag(t_b).message)
+            restored_b = state_diag(t_b)
+            time.sleep(3.0)
+            b.send_signal(signal.SIGINT)  # stopped: it writes at shutdown
+            b.wait(timeout=20)
+            with open(path, "rb") as f:
+                record = f.read()
+            with open(path, "wb") as f:
+                f.write(record[: len(record) // 2])
+            t_c = time.time()
+            c = start()
+            procs.append(c)
+            third = first_valid(t_c, 30.0)
+            self.assertIsNotNone(third, "no status with data after the third start")
+            self.assertTrue(third.conicity_from_estimate, (third.level, third.reason))
+            self.assertTrue(wait_for(lambda: state_diag(t_c) is not None and
+                                     state_diag(t_c).message.startswith(f"restored from {path}.prev"), 10.0),
+                            state_diag(t_c) and state_diag(t_c).message)
+            restored_c = state_diag(t_c)
+            self.assertIn(f"{path}: truncated: {len(record) // 2} of {len(record)} bytes", restored_c.message)
+            self.assertEqual(restored_c.level, 1)  # WARN: the file was damaged
+            t_written = time.time()
+            self.assertTrue(wait_for(lambda: int(dict((v.key, v.value) for v in state_diag(t_written).values)["writes"])
+                                     > 0 if state_diag(t_written) else False, 10.0), "no write after the restore")
+            took = {v.key: v.value for v in state_diag(t_written).values}["last write took [ms]"]
+            names = {0: "NO_DATA", 1: "OK", 2: "WATCH", 3: "WARN", 4: "ALARM"}
+            print(f"  identified {t_identified:.1f} s after the first start (the prior: {names[fresh.level]}); killed: "
+                  f"[{before[-1].hopf_speed_kmh_low:.3f}, {before[-1].hopf_speed_kmh_high:.3f}] "
+                  f"{names[before[-1].level]}; restarted: first status with data "
+                  f"{first.header.stamp.to_sec() - t_b:.1f} s after the start ({n_before_first} before it without data), [{first.hopf_speed_kmh_low:.3f}, "
+                  f"{first.hopf_speed_kmh_high:.3f}] {names[first.level]} (the killed one's "
+                  f"{t_kill - match.header.stamp.to_sec():.1f} s before the kill); '{restored_b.message}'; truncated: "
+                  f"'{restored_c.message}'; a write took {took} ms")
+        finally:
+            for sub in subs:
+                sub.unregister()
+            for p in reversed(procs):
+                if p.poll() is None:
+                    p.terminate()
+                    p.wait(timeout=20)
 
 
 if __name__ == "__main__":

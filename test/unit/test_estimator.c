@@ -3,27 +3,11 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "hm_alloc_count.h"
 #include "hm_test.h"
 #include "hunting_monitor/estimator.h"
 #include "hunting_monitor/linear.h"
 
-/* Allocation counter: the test binary is linked with --wrap for malloc, calloc and realloc. */
-static long n_allocations;
-void *__real_malloc(size_t n);
-void *__real_calloc(size_t n, size_t m);
-void *__real_realloc(void *p, size_t n);
-void *__wrap_malloc(size_t n) {
-  ++n_allocations;
-  return __real_malloc(n);
-}
-void *__wrap_calloc(size_t n, size_t m) {
-  ++n_allocations;
-  return __real_calloc(n, m);
-}
-void *__wrap_realloc(void *p, size_t n) {
-  ++n_allocations;
-  return __real_realloc(p, n);
-}
 
 static int all_finite(const hm_estimate *r) {
   return isfinite(r->time_s) && isfinite(r->speed_kmh) && isfinite(r->amplitude_accel_mps2) &&

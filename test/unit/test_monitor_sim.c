@@ -486,15 +486,10 @@ static void braking_through_the_fold_holds_and_says_why(void) {
 int main(int argc, char **argv) {
   if (argc > 1 && strcmp(argv[1], "--short") == 0) n_seeds = 1;
   hm_vehicle_default(&vehicle);
-  hm_table table = NULL;
-  if (hm_test_small_table(&table) != HM_OK) {
+  if (hm_test_small_table_text(&table_text, &table_len) != HM_OK) {
     printf("FAIL table_build\n");
     return 1;
   }
-  hm_table_format(table, NULL, 0, &table_len);
-  table_text = malloc(table_len);
-  hm_table_format(table, table_text, table_len, &table_len);
-  hm_table_destroy(table);
   HM_RUN(below_lowest_cycle_speed_stays_ok);
   HM_RUN(hunting_onset_alarms_within_a_second);
   HM_RUN(table_refined_at_the_conicity_in_use);
