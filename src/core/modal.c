@@ -456,15 +456,20 @@ static int fit_reading(hm_modal m, warm_start *ws, const window_geometry *g, siz
   return 1;
 }
 
-/* A mode as narrow as a line (|sigma| within two standard errors of the a line's reading, which the window's
- * leakage puts below 10 / T) and a line at f_hz inside its peak (three of its half-widths |sigma| + 2 / T): the line
- * and the mode near its Hopf speed look alike in one window (modal.h); a narrow mode's own peak, over a window a few
- * times its correlation time 1 / |sigma|, holds a few such "lines" (at 510 km/h, -0.4 1/s, one 0.05 Hz off its
- * centre passed the F test and, set aside, took the mode with it). */
-static int narrow_on(const window_geometry *g, const hm_mode_reading *r, double f_hz) {
+/* A mode as narrow as a line (line_narrow: |sigma| within two standard errors of the a line's reading, which the
+ * window's leakage puts below 10 / T) and a line at f_hz inside its peak (in_peak: three of its half-widths |sigma| +
+ * 2 / T, two frequency errors more): the line and the mode near its Hopf speed look alike in one window (modal.h); a
+ * narrow mode's own peak, over a window a few times its correlation time 1 / |sigma|, holds a few such "lines" (at 510
+ * km/h, -0.4 1/s, one 0.05 Hz off its centre passed the F test and, set aside, took the mode with it). */
+static int line_narrow(const window_geometry *g, const hm_mode_reading *r) {
+  return fabs(r->decay_rate_1_s) <= 10.0 / g->T + 2.0 * r->decay_rate_se_1_s;
+}
+static int in_peak(const window_geometry *g, const hm_mode_reading *r, double f_hz) {
   const double half_hz = (fabs(r->decay_rate_1_s) + HM_WHITTLE_LEAKAGE / g->T) / (2.0 * HM_PI);
-  return fabs(r->decay_rate_1_s) <= 10.0 / g->T + 2.0 * r->decay_rate_se_1_s &&
-         fabs(f_hz - r->frequency_hz) <= 3.0 * half_hz + 2.0 * r->frequency_se_hz;
+  return fabs(f_hz - r->frequency_hz) <= 3.0 * half_hz + 2.0 * r->frequency_se_hz;
+}
+static int narrow_on(const window_geometry *g, const hm_mode_reading *r, double f_hz) {
+  return line_narrow(g, r) && in_peak(g, r, f_hz);
 }
 
 /* Which of the lone candidates in the band are sinusoids (lines.h's harmonic F test at HM_MODAL_LINE_F or more, or at
@@ -521,15 +526,13 @@ static void set_line_aside(hm_modal m, const window_geometry *g, const hm_lines_
 static unsigned mask_far_candidates(hm_modal m, const window_geometry *g, const hm_lines_result *lr,
                                     const hm_mode_reading *rd) {
   if (!isfinite(rd->decay_rate_1_s) || !isfinite(rd->frequency_hz)) return 0;
-  /* (see above) */
-  if (fabs(rd->decay_rate_1_s) <= 10.0 / g->T + 2.0 * rd->decay_rate_se_1_s) return 0;
-  const double half_hz = (fabs(rd->decay_rate_1_s) + HM_WHITTLE_LEAKAGE / g->T) / (2.0 * HM_PI);
+  if (line_narrow(g, rd)) return 0;
   const size_t nbins = m->nfft / 2 + 1;
   unsigned count = 0;
   for (unsigned j = 0; j < lr->n_lone; ++j) {
     const size_t k = lr->lone_bin[j];
     if (k < g->k0 || k > g->k1 || m->set_aside[k]) continue;
-    if (fabs(lr->lone_hz[j] - rd->frequency_hz) <= 3.0 * half_hz + 2.0 * rd->frequency_se_hz) continue;
+    if (in_peak(g, rd, lr->lone_hz[j])) continue;
     count += hm_lines_mark(m->lines, lr->lone_hz[j], lr->lone_ratio[j], g->spread_rel, nbins, g->df, g->T,
                            m->set_aside) > 0;
   }
