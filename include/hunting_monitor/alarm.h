@@ -335,20 +335,23 @@ hm_status hm_alarm_update(hm_alarm alarm, const hm_estimate *est, const hm_margi
                           hm_assessment *out);
 
 /* What the alarm holds that must outlive a restart (state.h), times as ages before a "now" [s]: a held ALARM with its
- * cause, the hunted-at speed while it counts (during the hold and memory_s after it), and whether the estimate was in
- * use alone (the hysteresis of conicity_max_se). The level's hold, the calm seen and the speed's trend start again,
- * as at hm_alarm_restart. */
+ * cause, the hunted-at speed while it counts (during the hold and memory_s after it), whether the estimate was in
+ * use alone, the hysteresis of conicity_max_se (se_ok) and a dropped estimate's wait before it is used alone again
+ * (precise_lost: the wait starts again, its full HM_ALARM_FLAG_CLEAR_S, at the restore). The level's hold, the calm
+ * seen and the speed's trend start again, as at hm_alarm_restart. */
 typedef struct {
   int latched;              /* an oscillation ALARM held */
   hm_reason latch_reason;   /* its cause (a criterion, or the amplitude beyond the unstable cycle) */
   double hunted_at_kmh;     /* the lowest speed at which an oscillation met a criterion (INFINITY: none) */
   double hunted_age_s;      /* how long ago [s]; NAN: its age counts from the next update (a restarted time line) */
   int precise;              /* the estimate was in use alone at the last update with data */
+  int se_ok;                /* its standard error was within conicity_max_se (once so, 1.25 times it) */
+  int precise_lost;         /* it had stopped being used alone and was waiting to be used so again */
 } hm_alarm_snapshot;
 
 /* What a holds as of now_s (its time line), ages clamped at 0; nothing is written for NULL or a non-finite now_s. */
 void hm_alarm_take_snapshot(const hm_alarm alarm, double now_s, hm_alarm_snapshot *out);
-/* Every field in its range (HM_EDOMAIN, "field: reason" in why): latched and precise 0 or 1, a latch's cause an
+/* Every field in its range (HM_EDOMAIN, "field: reason" in why): latched, precise, se_ok and precise_lost 0 or 1, a latch's cause an
  * oscillation's, the hunted-at speed in (0, 2000] km/h or INFINITY, its age finite and >= 0 or NAN. */
 hm_status hm_alarm_snapshot_validate(const hm_alarm_snapshot *snap, char *why, size_t why_len);
 /* As hm_alarm_reset, then snap's latch (the level ALARM with its cause, as hm_alarm_restart keeps it), hunted-at speed

@@ -10,9 +10,10 @@
  * conicity estimate and both Hopf intervals follow from them, computed the same way after the restart), the misfit
  * windows, the conicity changes (count, age of the last, windows since), the latest window's narrow-peak verdict and
  * the latest ambiguous one (a line or the mode: it holds WATCH for HM_ALARM_NARROW_HOLD_S); the alarm's held ALARM with
- * its cause, the hunted-at speed while it counts, and the hysteresis of conicity_max_se. Not kept: the stream (the
- * estimator's filters, the identification's samples, the current steady stretch: a restart ends it as a gap does, its
- * provisional window kept as committed), the level's hold and the speed's trend (hm_alarm_restart's rules).
+ * its cause, the hunted-at speed while it counts, and the estimate's use alone with its hysteresis (conicity_max_se's,
+ * and a dropped estimate's wait, started again). Not kept: the stream (the estimator's filters, the identification's
+ * samples, the current steady stretch: a restart ends it as a gap does, its provisional window kept as committed), the
+ * level's hold and the speed's trend (hm_alarm_restart's rules).
  *
  * Restored only when the record is whole and meant for this monitor, else refused with the reason (the monitor is
  * untouched and starts from the prior): the magic; the length it declares (shorter: truncated); the checksum; the
@@ -32,7 +33,7 @@
  *     offset  size  field
  *          0     8  magic "HMSTATE\0"
  *          8     4  u32 format version (1)
- *         12     4  u32 length of the whole record in bytes (128 + 72 n_windows + 8 n_misfits)
+ *         12     4  u32 length of the whole record in bytes (136 + 72 n_windows + 8 n_misfits)
  *         16     8  u64 hash of the vehicle and settings (hm_state_hash)
  *         24     8  f64 written_unix_s: the wall clock at writing [s since 1970-01-01 UTC]
  *         32     8  f64 written_line_s: the writer's time line at writing [s] (the now the ages count from)
@@ -43,7 +44,8 @@
  *                4  u32 narrow verdict (hm_narrow_verdict); 8 f64 narrow_peak_hz; 8 f64 narrow_age_s (inf: none);
  *                8  f64 ambiguous_age_s (inf: none)
  *                4  u32 latched; 4 u32 latch_reason (hm_reason); 8 f64 hunted_at_kmh (inf: none);
- *                8  f64 hunted_age_s (NaN: counted from the next update); 4 u32 precise
+ *                8  f64 hunted_age_s (NaN: counted from the next update); 4 u32 precise;
+ *                4  u32 se_ok; 4 u32 precise_lost
  *     length - 4  4  u32 CRC-32 (IEEE 802.3, as zlib's crc32) of every byte before it
  * The magic, the version and the length at the front and the CRC-32 at the end are the same in every version.
  * hm_state_save and hm_state_restore allocate nothing and do no I/O; hm_state_save_file allocates nothing,
@@ -64,7 +66,7 @@ extern "C" {
 
 #define HM_STATE_VERSION 1u
 /* The largest record of version 1 [bytes]: 64 windows and 64 misfits. */
-#define HM_STATE_MAX_BYTES (128u + 80u * HM_MARGIN_MAX_WINDOWS)
+#define HM_STATE_MAX_BYTES (136u + 80u * HM_MARGIN_MAX_WINDOWS)
 /* An outcome's text [bytes, with the NUL]. */
 #define HM_STATE_TEXT_MAX 512
 

@@ -770,6 +770,8 @@ void hm_alarm_take_snapshot(const hm_alarm a, double now, hm_alarm_snapshot *out
   s.hunted_at_kmh = counts ? a->hunted_at_kmh : INFINITY;
   s.hunted_age_s = counts && !isnan(a->hunted_t_s) ? fmax(now - a->hunted_t_s, 0.0) : counts ? NAN : 0.0;
   s.precise = a->precise;
+  s.se_ok = a->se_ok;
+  s.precise_lost = a->precise_lost;
   *out = s;
 }
 
@@ -785,6 +787,8 @@ hm_status hm_alarm_snapshot_validate(const hm_alarm_snapshot *s, char *why, size
            !(isfinite(s->hunted_age_s) && s->hunted_age_s >= 0.0))
     field = "hunted_age_s: finite and >= 0, or NAN";
   else if (s->precise != 0 && s->precise != 1) field = "precise: 0 or 1";
+  else if (s->se_ok != 0 && s->se_ok != 1) field = "se_ok: 0 or 1";
+  else if (s->precise_lost != 0 && s->precise_lost != 1) field = "precise_lost: 0 or 1";
   if (!field) return HM_OK;
   if (why && len) snprintf(why, len, "alarm: %s", field);
   return HM_EDOMAIN;
@@ -803,5 +807,7 @@ hm_status hm_alarm_restore(hm_alarm a, double now, const hm_alarm_snapshot *s, c
   a->hunted_at_kmh = s->hunted_at_kmh;
   a->hunted_t_s = s->hunted_at_kmh < INFINITY && !isnan(s->hunted_age_s) ? now - s->hunted_age_s : NAN;
   a->precise = s->precise;
+  a->se_ok = s->se_ok;
+  a->precise_lost = s->precise_lost; /* (precise_since NAN: the wait counts from the first update) */
   return HM_OK;
 }

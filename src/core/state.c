@@ -7,7 +7,7 @@
 #include <string.h>
 
 static const unsigned char magic[8] = {'H', 'M', 'S', 'T', 'A', 'T', 'E', '\0'};
-enum { HEADER_BYTES = 40, FIXED_BYTES = 128, WINDOW_BYTES = 72, MISFIT_BYTES = 8 };
+enum { HEADER_BYTES = 40, FIXED_BYTES = 136, WINDOW_BYTES = 72, MISFIT_BYTES = 8 };
 
 void hm_state_config_default(hm_state_config *cfg) {
   if (cfg) cfg->period_s = 2.0;
@@ -167,6 +167,8 @@ hm_status hm_state_save(const hm_monitor m, double now_s, double written_unix_s,
   put_f64(&w, a->hunted_at_kmh);
   put_f64(&w, a->hunted_age_s);
   put_u32(&w, (uint32_t)a->precise);
+  put_u32(&w, (uint32_t)a->se_ok);
+  put_u32(&w, (uint32_t)a->precise_lost);
   put_u32(&w, hm_state_checksum(buf, w.at));
   *len = w.at;
   return HM_OK;
@@ -209,6 +211,9 @@ static int read_payload(reader *r, hm_monitor_snapshot *s) {
   a->hunted_age_s = get_f64(r);
   const uint32_t precise = get_u32(r);
   a->precise = precise <= 1 ? (int)precise : 2;
+  const uint32_t se_ok = get_u32(r), lost = get_u32(r);
+  a->se_ok = se_ok <= 1 ? (int)se_ok : 2;
+  a->precise_lost = lost <= 1 ? (int)lost : 2;
   if (n_changes != (uint64_t)g->n_changes) return 0;
   return !r->short_read && r->at + 4 == r->len; /* the checksum follows */
 }

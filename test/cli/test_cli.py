@@ -573,7 +573,7 @@ def test_estimate_state_survives_a_restart():
         with open(p["state"], "rb") as f:
             rec = f.read()
         version, length = struct.unpack("<II", rec[8:16])
-        assert rec[:8] == b"HMSTATE\0" and version == 1 and length == len(rec) == 128 + 72 * at60["windows_used"], \
+        assert rec[:8] == b"HMSTATE\0" and version == 1 and length == len(rec) == 136 + 72 * at60["windows_used"], \
             (rec[:16], len(rec))
         assert struct.unpack("<I", rec[-4:])[0] == zlib.crc32(rec[:-4]), "CRC-32"
         assert os.path.exists(p["state"] + ".prev"), "the previous state is kept"

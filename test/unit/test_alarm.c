@@ -988,6 +988,55 @@ static void what_the_model_may_not_explain(void) {
   hm_alarm_destroy(a);
 }
 
+/* A restore keeps the estimate's hysteresis (state.h, hm_alarm_snapshot): restored while the estimate of 0.16 is in
+ * use alone with a standard error of 0.011 (inside 1.25 times conicity_max_se, 0.010, which only its hysteresis
+ * admits), the restored alarm assesses as the one never restarted for 30 s, the interval its closed-form critical
+ * speeds at 0.16 -+ 0.006 (the review's case: a restore had refused it and shown the prior's higher interval); restored
+ * while a dropped estimate waits out HM_ALARM_FLAG_CLEAR_S before it is used alone again, it waits too (the restore had
+ * skipped the wait). */
+static void a_restore_keeps_the_hysteresis(void) {
+  hm_margin_estimate g = identified();
+  const hm_estimate e = estimate(400.0, 0.0);
+  hm_assessment s, t;
+  hm_alarm_snapshot snap;
+  char why[200] = "";
+  hm_alarm a = make(), b = make();
+  g.conicity_se = 0.009;
+  hm_alarm_update(a, &e, &g, 0.0, &s);
+  g.conicity_se = 0.011;
+  hm_alarm_update(a, &e, &g, 1.0, &s);
+  hm_alarm_take_snapshot(a, 1.0, &snap);
+  HM_CHECK(hm_alarm_restore(b, 1.0, &snap, why, sizeof why) == HM_OK, "restore: %s", why);
+  int same = 1;
+  for (int k = 2; k <= 30; ++k) {
+    hm_alarm_update(a, &e, &g, k, &s);
+    hm_alarm_update(b, &e, &g, k, &t);
+    same = same && s.conicity_from_estimate == t.conicity_from_estimate && s.hopf_low_kmh == t.hopf_low_kmh &&
+           s.hopf_high_kmh == t.hopf_high_kmh && s.warn_from_kmh == t.warn_from_kmh;
+  }
+  printf("  se 0.011, restored: alone %d (never restarted %d), [%.1f, %.1f] km/h\n", t.conicity_from_estimate,
+         s.conicity_from_estimate, t.hopf_low_kmh, t.hopf_high_kmh);
+  HM_CHECK(s.conicity_from_estimate && same, "the restored alarm as the one never restarted");
+  HM_CHECK_DELTA(t.hopf_low_kmh, hopf_closed_form(0.166), 1e-6, "interval's lower end");
+  HM_CHECK_DELTA(t.hopf_high_kmh, hopf_closed_form(0.154), 1e-6, "interval's upper end");
+  hm_alarm_destroy(a), hm_alarm_destroy(b);
+  /* dropped (outside the prior for one update), in again, waiting: restored at 2 s, neither uses it alone at 3 s */
+  hm_alarm c = make(), d = make();
+  g = identified();
+  hm_alarm_update(c, &e, &g, 0.0, &s);
+  g.outside_prior = -1;
+  hm_alarm_update(c, &e, &g, 1.0, &s);
+  g.outside_prior = 0;
+  hm_alarm_update(c, &e, &g, 2.0, &s);
+  hm_alarm_take_snapshot(c, 2.0, &snap);
+  HM_CHECK(hm_alarm_restore(d, 2.0, &snap, why, sizeof why) == HM_OK, "restore: %s", why);
+  hm_alarm_update(c, &e, &g, 3.0, &s);
+  hm_alarm_update(d, &e, &g, 3.0, &t);
+  HM_CHECK(!s.conicity_from_estimate && !t.conicity_from_estimate, "waiting: never restarted %d, restored %d",
+           s.conicity_from_estimate, t.conicity_from_estimate);
+  hm_alarm_destroy(c), hm_alarm_destroy(d);
+}
+
 int main(void) {
   hm_vehicle_default(&vehicle);
   if (hm_test_small_table(&table) != HM_OK) {
@@ -1007,6 +1056,7 @@ int main(void) {
   HM_RUN(what_the_model_may_not_explain);
   HM_RUN(provisional_windows_do_not_chatter);
   HM_RUN(conicity_outside_the_table);
+  HM_RUN(a_restore_keeps_the_hysteresis);
   hm_table_destroy(table);
   HM_TEST_EXIT();
 }

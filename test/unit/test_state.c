@@ -113,7 +113,7 @@ static void restart_continues_the_assessment(void) {
   n_allocations = 0;
   HM_CHECK(hm_state_save(f.mon[0], t_save, WALL0, good, sizeof good, &good_len) == HM_OK, "save");
   HM_CHECK(n_allocations == 0, "save allocated %ld times", n_allocations);
-  HM_CHECK(good_len == 128 + 72, "record of %zu bytes for one window", good_len);
+  HM_CHECK(good_len == 136 + 72, "record of %zu bytes for one window", good_len);
   /* B: restored on its own time line at the moment of writing (age 0 on the wall clock) */
   f.mon[1] = make_monitor(NULL, NULL);
   f.shift[1] = 955.0;
@@ -256,13 +256,13 @@ static void refusals_leave_the_monitor_untouched(void) {
   expect_refused(d, bad, good_len, now, wall, HM_STATE_CLOCK_WALL, HM_EPARSE, HM_STATE_CORRUPT, "checksum",
                  "corrupt byte");
   expect_refused(d, good, good_len - 1, now, wall, HM_STATE_CLOCK_WALL, HM_EPARSE, HM_STATE_TRUNCATED,
-                 "truncated: 199 of 200 bytes", "truncated by one");
+                 "truncated: 207 of 208 bytes", "truncated by one");
   expect_refused(d, good, 10, now, wall, HM_STATE_CLOCK_WALL, HM_EPARSE, HM_STATE_TRUNCATED, "truncated: 10 bytes",
                  "truncated to 10");
   expect_refused(d, good, 0, now, wall, HM_STATE_CLOCK_WALL, HM_EPARSE, HM_STATE_TRUNCATED, "truncated", "empty");
   memcpy(bad, good, good_len);
   bad[good_len] = 0;
-  expect_refused(d, bad, good_len + 1, now, wall, HM_STATE_CLOCK_WALL, HM_EPARSE, HM_STATE_CORRUPT, "declares 200",
+  expect_refused(d, bad, good_len + 1, now, wall, HM_STATE_CLOCK_WALL, HM_EPARSE, HM_STATE_CORRUPT, "declares 208",
                  "a byte beyond");
   expect_refused(d, (const unsigned char *)"hunting_monitor_boundary_table 1\n", 33, now, wall, HM_STATE_CLOCK_WALL,
                  HM_EPARSE, HM_STATE_NOT_A_STATE, "no HMSTATE magic", "another file");
@@ -351,7 +351,7 @@ static void the_file_and_its_previous_one(void) {
   write_bytes(path, good, good_len / 2);
   HM_CHECK(hm_state_restore_file(b, path, 100.0, WALL0 + 3.0, HM_STATE_CLOCK_WALL, &o) == HM_OK &&
                strstr(o.text, "restored from ") && strstr(o.text, "state.prev, age 3 s, 1 window (") &&
-               strstr(o.text, "/state: truncated: 100 of 200 bytes)") && o.from_prev,
+               strstr(o.text, "/state: truncated: 104 of 208 bytes)") && o.from_prev,
            "from prev: %s", o.text);
   printf("  %s\n", o.text);
   write_bytes(prev, (const unsigned char *)"x", 1);
