@@ -528,10 +528,13 @@ static unsigned mask_far_candidates(hm_modal m, const window_geometry *g, const 
   if (!isfinite(rd->decay_rate_1_s) || !isfinite(rd->frequency_hz)) return 0;
   if (line_narrow(g, rd)) return 0;
   const size_t nbins = m->nfft / 2 + 1;
+  /* a chance candidate (a bin exp(-ratio) likely) in the band's bins, harmless and in most windows, costs no refit:
+   * only one beyond chance at 1e-3 over the band counts */
+  const double chance_ratio = log((double)(g->k1 - g->k0 + 1) / g->padding) + log(1e3);
   unsigned count = 0;
   for (unsigned j = 0; j < lr->n_lone; ++j) {
     const size_t k = lr->lone_bin[j];
-    if (k < g->k0 || k > g->k1 || m->set_aside[k]) continue;
+    if (k < g->k0 || k > g->k1 || m->set_aside[k] || lr->lone_ratio[j] < chance_ratio) continue;
     if (in_peak(g, rd, lr->lone_hz[j])) continue;
     count += hm_lines_mark(m->lines, lr->lone_hz[j], lr->lone_ratio[j], g->spread_rel, nbins, g->df, g->T,
                            m->set_aside) > 0;
