@@ -87,6 +87,22 @@ double hm_clock_offset_s(const hm_clock *c);
  * never earlier than the previous result (the offset moves up by the least latency's changes). */
 double hm_clock_to_sensor(hm_clock *c, double receiver_s);
 
+/* The receiver's clock watched against a steady one (a monotonic clock no time correction moves): a step of the
+ * receiver's clock (an NTP correction either way) is its advance beyond the steady clock's since the last call.
+ * Forward steps cannot be seen in the stamps: a receipt time that steps forward by dt reads as every sample dt late
+ * (stale for up to window_s when dt exceeds the estimator's timeout; issue #27's review: +0.25 s gave NO_DATA for 8.5
+ * s); the caller shifts the offset by the step instead (hm_clock_shift). Not for a simulated clock (a bag's /clock),
+ * which has no steady counterpart. */
+typedef struct {
+  int have;                          /* 1 after the first call */
+  double last_receiver_s, last_steady_s;
+} hm_clock_watch;
+
+/* The receiver clock's step [s] since the last call (receiver advance - steady advance) where its magnitude exceeds
+ * min_step_s, else 0; the first call (or non-finite times, which are not kept) gives 0. Between calls milliseconds to
+ * seconds apart an NTP slew (at most 500 ppm) moves the clocks apart by well under a millisecond. */
+double hm_clock_watch_step(hm_clock_watch *w, double receiver_s, double steady_s, double min_step_s);
+
 #ifdef __cplusplus
 }
 #endif

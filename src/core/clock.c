@@ -73,11 +73,16 @@ void hm_clock_shift(hm_clock *c, double delta_s) {
   if (!isnan(c->away_since_s)) c->away_since_s += delta_s;
 }
 
-/* d enters the window: blocks of window_s / HM_CLOCK_BLOCKS of receipt time; the offset is their least value. */
-static void enter(hm_clock *c, double d, double receipt_s) {
+/* d enters the window: blocks of window_s / HM_CLOCK_BLOCKS of receipt time; the offset is their least value. After a
+ * silence longer than the window the window starts again, from the offset it had where d is a stall's backlog (late,
+ * its stamps continuous: backlog), and the receiver's times taken onto the sensor's line stay monotonic (a stall of
+ * 20 s had anchored the offset on the backlog's first sample, 20 s late, and moved that line back by 20 s). */
+static void enter(hm_clock *c, double d, double receipt_s, int backlog) {
   const double block_s = c->cfg.window_s / HM_CLOCK_BLOCKS;
   if (receipt_s - c->block_start_s >= c->cfg.window_s + block_s) {  /* silent for longer than the window */
-    anchor(c, d, receipt_s);
+    const double offset = c->offset_s, mapped = c->last_mapped_s;
+    anchor(c, backlog ? fmin(d, offset) : d, receipt_s);
+    c->last_mapped_s = mapped;
     return;
   }
   while (receipt_s - c->block_start_s >= block_s) {
@@ -107,7 +112,8 @@ hm_status hm_clock_observe(hm_clock *c, double stamp_s, double receipt_s, hm_clo
   }
   const double dev = d - c->offset_s;
   int chained = 1; /* the stamp continues the stamps used (a late one that does not is used, not chained on) */
-  if (dev > c->cfg.max_step_s && continues(c, stamp_s)) { /* a stall's backlog: late, its stamps continuous */
+  const int backlog = dev > c->cfg.max_step_s && continues(c, stamp_s);
+  if (backlog) { /* a stall's backlog: late, its stamps continuous */
     c->n_late++;
     c->away_since_s = NAN;
   } else if (fabs(dev) > c->cfg.max_step_s) {
@@ -129,7 +135,7 @@ hm_status hm_clock_observe(hm_clock *c, double stamp_s, double receipt_s, hm_clo
   } else {
     c->away_since_s = NAN;
   }
-  enter(c, d, receipt_s);
+  enter(c, d, receipt_s, backlog);
   c->latency_s = d - c->offset_s;
   if (chained) c->last_stamp_s = stamp_s;
   *verdict = HM_CLOCK_USE;
@@ -144,4 +150,13 @@ double hm_clock_to_sensor(hm_clock *c, double receiver_s) {
   if (c->have_offset && t < c->last_mapped_s) t = c->last_mapped_s;
   if (c->have_offset) c->last_mapped_s = t;
   return t;
+}
+
+double hm_clock_watch_step(hm_clock_watch *w, double receiver_s, double steady_s, double min_step_s) {
+  if (!w || !isfinite(receiver_s) || !isfinite(steady_s)) return 0.0;
+  const double step = w->have ? (receiver_s - w->last_receiver_s) - (steady_s - w->last_steady_s) : 0.0;
+  w->have = 1;
+  w->last_receiver_s = receiver_s;
+  w->last_steady_s = steady_s;
+  return fabs(step) > min_step_s ? step : 0.0;
 }
