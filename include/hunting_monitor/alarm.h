@@ -14,8 +14,9 @@
  *  - an estimate too uncertain to be used alone, outside the prior's range by more than its error (margin.h's
  *    outside_prior: WATCH, HM_REASON_OUTSIDE_PRIOR), or of a conicity change not yet confirmed by a second window, is
  *    not used alone: precise (standard error within conicity_max_se) and above the prior's range (worn beyond it:
- *    its Hopf speed lower), or with a lightly damped mode among the windows held (margin.h's near_evidence:
- *    instability is near, whatever the model says), the level uses the more cautious of it and the prior (the lower
+ *    its Hopf speed lower), precise and a change's first window (the evidence of the change, at any speed), or with a
+ *    lightly damped mode among the windows held (margin.h's near_evidence: instability is near, whatever the model
+ *    says), the level uses the more cautious of it and the prior (the lower
  *    point, and the lower of each end), so an estimate can lower the interval (hollow-worn wheels do reach 0.3-0.5;
  *    0.176 +- 0.005 for 0.18 against a prior of 0.106-0.166 must not give the prior's 465-594 km/h for a Hopf speed of
  *    445) but never raise it above the prior's (a precise 0.08 would have put it at 657-742 km/h); otherwise the
@@ -77,7 +78,9 @@
  * Thresholds of the current (or a higher) level are relaxed by the hysteresis (hysteresis_kmh on speeds,
  * hysteresis_amplitude_fraction of the edge on amplitudes), a higher level is taken at once, and a lower one only
  * after the conditions for it have held for min_hold_s, and only if they would still hold at the speed the present
- * acceleration (averaged over HM_ALARM_TREND_S) reaches in HM_ALARM_LOWER_LOOKAHEAD_S: no chatter, also on a ramp. Every change carries a reason code.
+ * acceleration (averaged over HM_ALARM_TREND_S) reaches in HM_ALARM_LOWER_LOOKAHEAD_S: no chatter, also on a ramp
+ * (a latch's release, below, lowers the level at once: its release_s of calm was the hold). Every change carries a
+ * reason code.
  * Latching by cause (issue #21): an ALARM from the oscillation (a criterion, or the amplitude at or beyond the
  * unstable cycle) is latched: it holds, with its reason, until the oscillation has stayed calm for release_s (no
  * criterion met, the displacement amplitude below release_amplitude_fraction of the displacement criterion's limit,
@@ -228,7 +231,8 @@ typedef struct {
   double conicity;                  /* in use */
   double conicity_se;               /* its standard error (0 for the fallback) */
   int conicity_from_estimate;       /* the identified conicity alone (else the prior, or the more cautious of both) */
-  int conicity_from_prior;          /* the prior's range sets the interval (no estimate, or one too uncertain) */
+  int conicity_from_prior;          /* the prior's range sets the interval (no estimate, one too uncertain, or one
+                                       combined with the prior that moved neither end) */
   int boundaries_valid;             /* 0 with NO_DATA: nothing below is current */
   hm_table_lookup_result boundaries;/* at the conicity in use and the current speed */
   int conicity_outside_table;       /* +1 / -1: the conicity in use lies above / below the table's range; the boundaries
@@ -273,6 +277,8 @@ typedef struct {
   double hold_release_amplitude_m;  /* ... with the displacement amplitude below this and no criterion met */
   double calm_s, calm_needed_s;     /* calm so far and calm needed for the release (release_s) [s] */
   unsigned hold_waits;              /* what the release waits for: HM_HOLD_WAITS_* bits */
+  hm_reason hold_no_data;           /* with HM_HOLD_WAITS_DATA, what is missing (HM_REASON_NO_ACCEL, NO_SPEED or
+                                       BAD_SAMPLE_RATE: the level NO_DATA would have said); else HM_REASON_STARTUP */
   double hunted_at_s;               /* when the oscillation met a criterion at hunted_at_kmh (NAN: none) */
   double time_s;                    /* the update's time [s] */
   double speed_kmh;                 /* the speed judged (the estimate's; 0 without a current one) */
@@ -343,7 +349,9 @@ typedef struct {
   int latched;              /* an oscillation ALARM held */
   hm_reason latch_reason;   /* its cause (a criterion, or the amplitude beyond the unstable cycle) */
   double hunted_at_kmh;     /* the lowest speed at which an oscillation met a criterion (INFINITY: none) */
-  double hunted_age_s;      /* how long ago [s]; NAN: its age counts from the next update (a restarted time line) */
+  double hunted_age_s;      /* how long ago its memory_s started [s] (when it was met, or the latch's release if
+                               later; restored, it is also the time shown as hunted_at_s); NAN: its age counts from
+                               the next update (a restarted time line) */
   int precise;              /* the estimate was in use alone at the last update with data */
   int se_ok;                /* its standard error was within conicity_max_se (once so, 1.25 times it) */
   int precise_lost;         /* it had stopped being used alone and was waiting to be used so again */

@@ -145,7 +145,8 @@ typedef enum {
   HM_WINDOW_OVERLAPS = 4,
   HM_WINDOW_NO_INVERSION = 5,
   HM_WINDOW_MISFIT = 6,     /* the model explains its decay rate and frequency together no better than chi2 limit */
-  HM_WINDOW_CHANGE = 7,     /* its conicity disagrees with the windows held: they were dropped, and so was it */
+  HM_WINDOW_CHANGE = 7,     /* its conicity disagrees with the windows held: they were dropped and it is kept,
+                               committed (the evidence of the change) */
   HM_WINDOW_NONLINEAR = 8,  /* a criterion was met during it: hunting or its onset is not the linear mode
                                (monitor.h) */
   HM_WINDOW_AMBIGUOUS = 9,  /* its narrow peak may be a line or the mode at its Hopf speed, and neither reading is

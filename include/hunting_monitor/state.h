@@ -44,7 +44,8 @@
  *                4  u32 narrow verdict (hm_narrow_verdict); 8 f64 narrow_peak_hz; 8 f64 narrow_age_s (inf: none);
  *                8  f64 ambiguous_age_s (inf: none)
  *                4  u32 latched; 4 u32 latch_reason (hm_reason); 8 f64 hunted_at_kmh (inf: none);
- *                8  f64 hunted_age_s (NaN: counted from the next update); 4 u32 precise;
+ *                8  f64 hunted_age_s: its memory's age, from when it was met or the latch's release if later
+ *                   (NaN: counted from the next update); 4 u32 precise;
  *                4  u32 se_ok; 4 u32 precise_lost
  *     length - 4  4  u32 CRC-32 (IEEE 802.3, as zlib's crc32) of every byte before it
  * The magic, the version and the length at the front and the CRC-32 at the end are the same in every version.

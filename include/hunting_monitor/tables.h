@@ -78,7 +78,7 @@ void hm_table_destroy(hm_table t);
 typedef struct {
   double conicity;              /* the query's conicity, clamped to the table */
   double hopf_speed_kmh;        /* linear critical speed */
-  double l1;                    /* first Lyapunov coefficient there */
+  double l1;                    /* first Lyapunov coefficient there (NAN from a widened lookup: not known outside) */
   double lowest_cycle_speed_kmh;/* nonlinear critical speed: below it no cycle exists */
   int origin_stable;            /* speed below the Hopf speed */
   int has_edge;                 /* an unstable cycle bounds the basin of the stable origin at this speed */
@@ -101,7 +101,8 @@ hm_status hm_table_lookup(const hm_table t, double conicity, double speed_kmh, h
  * of the cycles at this speed, (a) the end conicity's own, (b) its family at this conicity's fraction of the Hopf
  * speed (Klingel), (c) the end interval extrapolated; the lowest cycle speed and the edge (the unstable cycle) the
  * least of (a) and of (b) and (c) less their difference, the stable outer cycle the largest so (the stated errors
- * the table's: the Hopf speed is exact, the rest widened already); clamped and widened set, conicity the end's. (On the table 0.12-0.16: at 0.20 and 0.25 the
+ * the table's: the Hopf speed is exact, the rest widened already); l1 NAN (not known there); clamped and widened
+ * set, conicity the end's. (On the table 0.12-0.16: at 0.20 and 0.25 the
  * lowest cycle speed 186.2 and 141.0 km/h for the continuation's 226.8 and 218.2, where the end's is 234.5; the edge
  * at 0.95 of the Hopf speed 7.35 and 7.23 mm for 7.40 and 7.33, the end's 8.13 and 8.52: test_tables. Cautious, and
  * far from exact that far out.) The end conicity's edge counts only below its own Hopf speed. A speed outside the

@@ -158,8 +158,9 @@ static void write_line(const hm_monitor_status *st, double t, const read_counts 
   jw_number(&w, "warn_from_kmh", b ? s->warn_from_kmh : NAN);
   jw_number(&w, "watch_from_kmh", b ? s->watch_from_kmh : NAN);
   jw_number(&w, "warn_risk", b ? s->warn_risk : NAN);
-  jw_number(&w, "hunted_at_kmh", b ? s->hunted_at_kmh : NAN);
-  jw_number(&w, "hunted_at_s", b ? s->hunted_at_s : NAN);
+  /* (a memory, not a margin: shown while it counts, also held without current data) */
+  jw_number(&w, "hunted_at_kmh", s->hunted_at_kmh);
+  jw_number(&w, "hunted_at_s", s->hunted_at_s);
   jw_bool(&w, "hopf_low_from_hunting", b && s->hopf_low_from_hunting);
   jw_number(&w, "anticipation_kmh", b ? s->anticipation_kmh : NAN);
   jw_number(&w, "lowest_cycle_kmh", b ? s->boundaries.lowest_cycle_speed_kmh : NAN);

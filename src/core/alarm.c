@@ -37,6 +37,8 @@ struct hm_alarm_s {
                              it (INFINITY: none) */
   double hunted_t_s;      /* when (the latest time it was met there or lower); NAN: on a time line that restarted,
                              its age counts from the next update */
+  double hunted_mem_s;    /* when its memory_s started: hunted_t_s, or the latch's release if later (alarm.h: for
+                             memory_s after the release; a latch longer than memory_s had dropped it at once) */
   double memory_s;        /* how long a hunted-at speed bounds the interval (hm_alarm_set_memory) */
   int precise;            /* the estimate was used alone at the last update with data */
   int se_ok;              /* its standard error was small enough at the last update with data (its hysteresis) */
@@ -132,7 +134,7 @@ size_t hm_assessment_reason_text(const hm_assessment *s, double origin_s, char *
   else
     append(buf, len, &n, " releases below the Hopf interval after %.0f s calm", s->calm_needed_s);
   if (s->hold_waits & HM_HOLD_WAITS_DATA) {
-    append(buf, len, &n, " (no current data: the calm is seen only with data)");
+    append(buf, len, &n, " (%s: the calm is seen only with data)", hm_reason_text(s->hold_no_data));
     return n;
   }
   append(buf, len, &n, " (calm %.1f s", s->calm_s);
@@ -265,7 +267,7 @@ void hm_alarm_restart(hm_alarm a) {
   a->since = 0.0;
   a->lower_pending = 0;
   a->calm = 0;
-  a->hunted_t_s = NAN; /* its age counts again from the next update */
+  a->hunted_t_s = a->hunted_mem_s = NAN; /* its age counts again from the next update */
   a->latch_since_s = a->latch_last_met_s = NAN;
   a->precise = a->precise_lost = a->se_ok = 0;
   a->precise_since = NAN;
@@ -286,6 +288,7 @@ void hm_alarm_shift_time(hm_alarm a, double delta_s) {
   a->mismatch.false_since_s += delta_s;
   a->free_beside.false_since_s += delta_s;
   a->hunted_t_s += delta_s;
+  a->hunted_mem_s += delta_s;
   a->latch_since_s += delta_s;
   a->latch_last_met_s += delta_s;
   a->block_t0_s += delta_s;
@@ -514,7 +517,11 @@ static hm_status assess(hm_alarm a, const hm_estimate *e, const hm_margin_estima
   const int alone = a->se_ok && !g->outside_prior && !unconfirmed_change;
   const int precise = regained(a, alone, now);
   const int cautious_precise = a->se_ok && g->outside_prior > 0;
-  const int usable = precise || alone || cautious_precise || (usable_model && g->near_evidence);
+  /* a change's first window, precise, is the evidence of the change (margin.h): combined with the prior (the more
+   * cautious) whatever its distance from the Hopf speed (issue #27: 0.12 -> 0.18 +- 0.008 at 300 km/h had left the
+   * prior alone, WATCH at 450 km/h above the new Hopf speed of 444.9) */
+  const int change_evidence = a->se_ok && unconfirmed_change;
+  const int usable = precise || alone || cautious_precise || change_evidence || (usable_model && g->near_evidence);
   /* the prior's interval, and the uncertain estimate's where it is the more cautious */
   double lambda = c->conicity_fallback, lambda_opt = c->conicity_prior_low;
   double lo = a->prior_hopf_low_kmh, hi = a->prior_hopf_high_kmh;
@@ -532,6 +539,8 @@ static hm_status assess(hm_alarm a, const hm_estimate *e, const hm_margin_estima
     if (g->hopf_model_kmh < hm_linear_hopf_kmh(&a->veh, lambda)) lambda = g->conicity, s->conicity_se = g->conicity_se;
     lo = fmin(lo, g->hopf_model_low_kmh);
     if (g->hopf_model_high_kmh < hi) hi = g->hopf_model_high_kmh, lambda_opt = g->conicity_low;
+    /* the prior sets the interval only where the estimate moved neither end */
+    s->conicity_from_prior = lo == a->prior_hopf_low_kmh && hi == a->prior_hopf_high_kmh;
   }
   /* the model-free interval's lower end counts when the model-based one does not (a mismatch, a sensor off the axle
    * box; then its upper end too: it is the only evidence of where the vehicle's Hopf speed lies, and on a bogie 40-60
@@ -608,12 +617,13 @@ static void below(const hm_alarm a, hm_assessment *s, double basis_kmh) {
  * the interval's lower end by their margins. */
 static void hunted_bound(hm_alarm a, const hm_estimate *e, double now, hm_assessment *s) {
   if (e->rms_exceeded || e->peaks_exceeded || e->displacement_exceeded) {
-    if (!a->latched && a->hunted_at_kmh < INFINITY && !(now - a->hunted_t_s <= a->memory_s))
+    if (!a->latched && a->hunted_at_kmh < INFINITY && !(now - a->hunted_mem_s <= a->memory_s))
       a->hunted_at_kmh = INFINITY; /* a new episode after the memory of the last one ran out */
-    if (e->speed_kmh <= a->hunted_at_kmh) a->hunted_at_kmh = e->speed_kmh, a->hunted_t_s = now;
+    if (e->speed_kmh <= a->hunted_at_kmh) a->hunted_at_kmh = e->speed_kmh, a->hunted_t_s = a->hunted_mem_s = now;
   }
   if (isnan(a->hunted_t_s) && a->hunted_at_kmh < INFINITY) a->hunted_t_s = now; /* a restarted time line */
-  if (!a->latched && !(now - a->hunted_t_s <= a->memory_s)) a->hunted_at_kmh = INFINITY;
+  if (isnan(a->hunted_mem_s) && a->hunted_at_kmh < INFINITY) a->hunted_mem_s = now;
+  if (!a->latched && !(now - a->hunted_mem_s <= a->memory_s)) a->hunted_at_kmh = INFINITY;
   s->hunted_at_kmh = a->hunted_at_kmh < INFINITY ? a->hunted_at_kmh : NAN;
   s->hunted_at_s = a->hunted_at_kmh < INFINITY ? a->hunted_t_s : NAN;
   if (a->hunted_at_kmh < INFINITY) { /* the thresholds below it by their margins, also inside the interval */
@@ -628,8 +638,11 @@ static void hunted_bound(hm_alarm a, const hm_estimate *e, double now, hm_assess
 }
 
 /* The latch (alarm.h) with data: an oscillation ALARM latches (its first cause and time kept); a latched one holds,
- * with that cause, until the release conditions have held for release_s. */
-static void latch(hm_alarm a, const hm_estimate *e, double now, hm_assessment *s, hm_level *target, hm_reason *reason) {
+ * with that cause, until the release conditions have held for release_s. 1 when it was released now (the level
+ * then falls at once: the calm release_s was its hold, and min_hold_s more showed an ALARM neither latched nor held
+ * with a criterion's reason that no longer held, issue #27). */
+static int latch(hm_alarm a, const hm_estimate *e, double now, hm_assessment *s, hm_level *target, hm_reason *reason) {
+  int released = 0;
   const int oscillation = *target == HM_LEVEL_ALARM && oscillation_reason(*reason);
   if (a->latched || oscillation) release_conditions(a, e, s);
   if (oscillation) {
@@ -641,7 +654,9 @@ static void latch(hm_alarm a, const hm_estimate *e, double now, hm_assessment *s
     if (s->hold_waits) a->calm = 0;
     else if (!a->calm) a->calm = 1, a->calm_since = now;
     if (a->calm && now - a->calm_since >= a->cfg.release_s) {
-      a->latched = 0; /* the hunted-at speed stays a bound for memory_s */
+      a->latched = 0; /* the hunted-at speed stays a bound for memory_s from now */
+      if (a->hunted_at_kmh < INFINITY) a->hunted_mem_s = fmax(a->hunted_mem_s, now);
+      released = 1;
     } else {
       *target = HM_LEVEL_ALARM;
       *reason = a->latch_cause;
@@ -650,6 +665,7 @@ static void latch(hm_alarm a, const hm_estimate *e, double now, hm_assessment *s
     }
   }
   s->latched = a->latched;
+  return released;
 }
 
 /* The hold in numbers (alarm.h): while latched its cause, times, calm so far and needed; else none. */
@@ -678,6 +694,7 @@ hm_status hm_alarm_update(hm_alarm a, const hm_estimate *e, const hm_margin_esti
   s.hunted_at_kmh = s.hunted_at_s = NAN;
   hm_reason reason;
   hm_level target;
+  int released = 0;
   if (!e->accel_valid || !e->speed_valid) {
     target = HM_LEVEL_NO_DATA;
     reason = !e->sample_rate_supported ? HM_REASON_BAD_SAMPLE_RATE
@@ -685,12 +702,15 @@ hm_status hm_alarm_update(hm_alarm a, const hm_estimate *e, const hm_margin_esti
                                        : HM_REASON_NO_SPEED;
     a->block_n = a->n_blocks = 0; /* no speed: the acceleration starts again */
     if (a->latched) { /* a held ALARM outlives its data: nothing says the oscillation has gone (alarm.h) */
+      s.hold_no_data = reason;
       target = HM_LEVEL_ALARM;
       reason = a->latch_cause;
       a->calm = 0;
       s.latched = s.held = 1;
       s.hold_release_below_kmh = s.hold_release_amplitude_m = NAN; /* no current boundaries */
       s.hold_waits = HM_HOLD_WAITS_DATA;
+      if (a->hunted_at_kmh < INFINITY) /* (it counts while held) */
+        s.hunted_at_kmh = a->hunted_at_kmh, s.hunted_at_s = a->hunted_t_s;
     }
   } else {
     const hm_status st = assess(a, e, g, &s);
@@ -722,12 +742,12 @@ hm_status hm_alarm_update(hm_alarm a, const hm_estimate *e, const hm_margin_esti
       hm_reason r_ahead;
       if (raw_level(a, &ahead, g, &s, a->level, &r_ahead) >= a->level) target = a->level, reason = a->reason;
     }
-    latch(a, e, now, &s, &target, &reason);
+    released = latch(a, e, now, &s, &target, &reason);
   }
   hold_numbers(a, now, &s);
   /* (with no data the latch is kept: nothing says the oscillation has gone) */
   s.changed = 0;
-  if (target >= a->level || target == HM_LEVEL_NO_DATA || a->level == HM_LEVEL_NO_DATA) {
+  if (target >= a->level || target == HM_LEVEL_NO_DATA || a->level == HM_LEVEL_NO_DATA || released) {
     a->lower_pending = 0;
     if (target != a->level) {
       a->level = target;
@@ -766,9 +786,9 @@ void hm_alarm_take_snapshot(const hm_alarm a, double now, hm_alarm_snapshot *out
   s.latch_reason = a->latched ? a->latch_cause : HM_REASON_STARTUP;
   /* the hunted-at speed while it counts (hunted_bound): held, on a restarted line, or within memory_s */
   const int counts = a->hunted_at_kmh < INFINITY &&
-                     (a->latched || isnan(a->hunted_t_s) || now - a->hunted_t_s <= a->memory_s);
+                     (a->latched || isnan(a->hunted_mem_s) || now - a->hunted_mem_s <= a->memory_s);
   s.hunted_at_kmh = counts ? a->hunted_at_kmh : INFINITY;
-  s.hunted_age_s = counts && !isnan(a->hunted_t_s) ? fmax(now - a->hunted_t_s, 0.0) : counts ? NAN : 0.0;
+  s.hunted_age_s = counts && !isnan(a->hunted_mem_s) ? fmax(now - a->hunted_mem_s, 0.0) : counts ? NAN : 0.0;
   s.precise = a->precise;
   s.se_ok = a->se_ok;
   s.precise_lost = a->precise_lost;
@@ -805,7 +825,8 @@ hm_status hm_alarm_restore(hm_alarm a, double now, const hm_alarm_snapshot *s, c
     a->latch_since_s = a->latch_last_met_s = NAN;
   }
   a->hunted_at_kmh = s->hunted_at_kmh;
-  a->hunted_t_s = s->hunted_at_kmh < INFINITY && !isnan(s->hunted_age_s) ? now - s->hunted_age_s : NAN;
+  a->hunted_t_s = a->hunted_mem_s =
+      s->hunted_at_kmh < INFINITY && !isnan(s->hunted_age_s) ? now - s->hunted_age_s : NAN;
   a->precise = s->precise;
   a->se_ok = s->se_ok;
   a->precise_lost = s->precise_lost; /* (precise_since NAN: the wait counts from the first update) */

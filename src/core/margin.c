@@ -47,7 +47,7 @@ const char *hm_window_verdict_text(hm_window_verdict v) {
     case HM_WINDOW_OVERLAPS: return "overlaps a window already used";
     case HM_WINDOW_NO_INVERSION: return "no conicity explains it";
     case HM_WINDOW_MISFIT: return "the model cannot explain its decay rate and frequency together";
-    case HM_WINDOW_CHANGE: return "the conicity changed: the windows held were dropped";
+    case HM_WINDOW_CHANGE: return "the conicity changed: the windows held were dropped, this one kept";
     case HM_WINDOW_NONLINEAR: return "a criterion was met during it: hunting is not the linear mode";
     case HM_WINDOW_AMBIGUOUS:
       return "a narrow peak: a line, or the mode at its Hopf speed at a conicity nothing else supports: not used";

@@ -187,7 +187,7 @@ hm_status hm_table_lookup_widened(const hm_table t, double conicity, double spee
   hm_table_lookup_result r = rc;
   r.conicity = t->curves[i + (size_t)w_end].conicity;
   r.clamped = r.widened = 1;
-  r.l1 = ra.l1;
+  r.l1 = NAN; /* not known outside the table: the end conicity's had been given, unflagged (issue #27's review) */
   r.lowest_cycle_speed_kmh = fmax(0.0, fmin(ra.lowest_cycle_speed_kmh, cautious(rb.lowest_cycle_speed_kmh,
                                                                                 rc.lowest_cycle_speed_kmh, -1.0)));
   /* (the end conicity's edge only where its own origin is stable: beyond its Hopf speed it has none to give) */

@@ -363,6 +363,7 @@ def test_tables_and_lookup():
                    if (a["v_kmh"] - 399.7) * (b["v_kmh"] - 399.7) <= 0 and a["v_kmh"] != b["v_kmh"] and not a["stable"])
         close(wide["hopf_kmh"], run_json("critical", "--conicity", "0.20")["v_crit_kmh"], 1e-6, "widened Hopf")
         assert wide["widened"] and wide["conicity"] == 0.2 and wide["table_conicity"] == 0.16, wide
+        assert wide["l1"] is None, wide  # not known outside the table (the end conicity's had been given)
         assert wide["lowest_cycle_kmh"] <= family["lowest_cycle_v_kmh"], (wide, family["lowest_cycle_v_kmh"])
         assert 0.8 * edge < wide["unstable_cycle_amplitude_m"] <= edge, (wide, edge)
         inside = run_json("table-lookup", "--table", tbl, "--conicity", "0.1358", "--v", "420", "--widen")

@@ -105,7 +105,8 @@ static void widened_lookup_is_cautious_outside(void) {
     hm_cycle_point *pts = direct_family_of(&veh, &np, ev, &ne, &o);
     const double lowest = hm_cycles_lowest(pts, np, ev, ne), hopf = hm_linear_hopf_kmh(&veh, conicities[k]);
     hm_table_lookup_result w, c;
-    HM_CHECK(hm_table_lookup_widened(table, conicities[k], 300.0, &w) == HM_OK && w.widened && w.clamped, "widened");
+    HM_CHECK(hm_table_lookup_widened(table, conicities[k], 300.0, &w) == HM_OK && w.widened && w.clamped && isnan(w.l1),
+             "widened, l1 not known (%g)", w.l1);
     HM_CHECK_REL(w.hopf_speed_kmh, hopf, 1e-9, "the widened Hopf speed against the closed form");
     HM_CHECK(hm_table_lookup(table, conicities[k], 300.0, &c) == HM_OK && c.clamped && !c.widened, "clamped");
     printf("  %.2f: Hopf %.1f km/h, lowest cycle speed direct %.1f, widened %.1f, clamped %.1f\n", conicities[k], hopf,
