@@ -23,7 +23,10 @@
  *  - earlier than possible (a stamp ahead of the receiver's now on the sensor's time line by more than max_step_s):
  *    dropped;
  * and if either lasts confirm_s of receipt time, the sensor's clock stepped: the offset is taken anew from that
- * sample (HM_CLOCK_STEPPED: the caller restarts what holds times of the old line).
+ * sample (HM_CLOCK_STEPPED: the caller restarts what holds times of the old line). After a silence longer than the
+ * window (nothing received for window_s and a block) a sample that departs and is no backlog is a step at once (a
+ * sensor rebooted while silent: there is nothing left to confirm it against). A stall's backlog after such a silence
+ * starts the window again from the offset it had.
  * No allocation; a plain struct the caller owns.
  */
 #ifndef HUNTING_MONITOR_CLOCK_H
@@ -86,22 +89,6 @@ double hm_clock_offset_s(const hm_clock *c);
 /* A receiver time on the sensor's time line: receiver_s - offset_s (receiver_s itself before the first sample),
  * never earlier than the previous result (the offset moves up by the least latency's changes). */
 double hm_clock_to_sensor(hm_clock *c, double receiver_s);
-
-/* The receiver's clock watched against a steady one (a monotonic clock no time correction moves): a step of the
- * receiver's clock (an NTP correction either way) is its advance beyond the steady clock's since the last call.
- * Forward steps cannot be seen in the stamps: a receipt time that steps forward by dt reads as every sample dt late
- * (stale for up to window_s when dt exceeds the estimator's timeout; issue #27's review: +0.25 s gave NO_DATA for 8.5
- * s); the caller shifts the offset by the step instead (hm_clock_shift). Not for a simulated clock (a bag's /clock),
- * which has no steady counterpart. */
-typedef struct {
-  int have;                          /* 1 after the first call */
-  double last_receiver_s, last_steady_s;
-} hm_clock_watch;
-
-/* The receiver clock's step [s] since the last call (receiver advance - steady advance) where its magnitude exceeds
- * min_step_s, else 0; the first call (or non-finite times, which are not kept) gives 0. Between calls milliseconds to
- * seconds apart an NTP slew (at most 500 ppm) moves the clocks apart by well under a millisecond. */
-double hm_clock_watch_step(hm_clock_watch *w, double receiver_s, double steady_s, double min_step_s);
 
 #ifdef __cplusplus
 }

@@ -113,6 +113,16 @@ hm_status hm_clock_observe(hm_clock *c, double stamp_s, double receipt_s, hm_clo
   const double dev = d - c->offset_s;
   int chained = 1; /* the stamp continues the stamps used (a late one that does not is used, not chained on) */
   const int backlog = dev > c->cfg.max_step_s && continues(c, stamp_s);
+  if (!backlog && fabs(dev) > c->cfg.max_step_s &&
+      receipt_s - c->block_start_s >= c->cfg.window_s * (1.0 + 1.0 / HM_CLOCK_BLOCKS)) {
+    /* off the line after a silence longer than the window: a new line at once (a sensor rebooted while silent; the
+     * window would have taken it in as the offset, the stamps gone back unseen: issue #27's review) */
+    anchor(c, d, receipt_s);
+    c->last_stamp_s = stamp_s;
+    c->n_steps++;
+    *verdict = HM_CLOCK_STEPPED;
+    return HM_OK;
+  }
   if (backlog) { /* a stall's backlog: late, its stamps continuous */
     c->n_late++;
     c->away_since_s = NAN;
@@ -150,13 +160,4 @@ double hm_clock_to_sensor(hm_clock *c, double receiver_s) {
   if (c->have_offset && t < c->last_mapped_s) t = c->last_mapped_s;
   if (c->have_offset) c->last_mapped_s = t;
   return t;
-}
-
-double hm_clock_watch_step(hm_clock_watch *w, double receiver_s, double steady_s, double min_step_s) {
-  if (!w || !isfinite(receiver_s) || !isfinite(steady_s)) return 0.0;
-  const double step = w->have ? (receiver_s - w->last_receiver_s) - (steady_s - w->last_steady_s) : 0.0;
-  w->have = 1;
-  w->last_receiver_s = receiver_s;
-  w->last_steady_s = steady_s;
-  return fabs(step) > min_step_s ? step : 0.0;
 }

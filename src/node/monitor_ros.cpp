@@ -273,20 +273,6 @@ void MonitorRos::checkRosTime(const ros::Time& now) {
       timeJumped(what, delta);
     }
   }
-  // a step forward (clock.h: it cannot be seen in the stamps, it reads as every sample late, i.e. stale); backward
-  // steps are the branch above. Not with simulated time, which has no steady counterpart.
-  const double forward =
-      ros::Time::isSimTime() ? 0.0 : hm_clock_watch_step(&ros_watch_, t, ros::SteadyTime::now().toSec(), 0.1);
-  if (forward > 0.0 && last_ros_time_ > 0.0) {
-    if (header_time_ && accel_type_ == "imu") {
-      ros_step_forward_ += forward;  // the next sample tells whether the stamps stepped with it (onAccelImu)
-    } else {
-      char what[160];
-      std::snprintf(what, sizeof what, "ROS time moved forwards by %.3f s (an NTP correction)", forward);
-      hm_clock_reset(&clock_);
-      timeJumped(what, forward);
-    }
-  }
   last_ros_time_ = t;
 }
 
@@ -323,21 +309,6 @@ void MonitorRos::onAccelImu(const sensor_msgs::Imu::ConstPtr& msg) {
       hm_clock_shift(&clock_, step);
       ROS_WARN("hunting_monitor: ROS time moved backwards by %.3f s, the sensor's stamps did not (an NTP correction): "
                "the clock offset follows it", -step);
-    }
-  }
-  if (ros_step_forward_ != 0.0) {
-    const double step = ros_step_forward_;
-    ros_step_forward_ = 0.0;
-    if (last_stamp_ > -1e300 && stamp > last_stamp_ + step * 0.5) {  // the stamps stepped forward with ROS time
-      char what[200];
-      std::snprintf(what, sizeof what, "ROS time and the sensor's stamps moved forwards by %.3f and %.3f s", step,
-                    stamp - last_stamp_);
-      hm_clock_reset(&clock_);
-      timeJumped(what, stamp - last_stamp_);
-    } else {  // ROS time alone: the clock's offset moves with it, the stamps' time line goes on
-      hm_clock_shift(&clock_, step);
-      ROS_WARN("hunting_monitor: ROS time moved forwards by %.3f s, the sensor's stamps did not (an NTP correction): "
-               "the clock offset follows it", step);
     }
   }
   const double before = clock_.offset_s;

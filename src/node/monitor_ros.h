@@ -98,8 +98,6 @@ class MonitorRos {
   hm_clock clock_{};
   double last_ros_time_ = 0.0;
   double ros_step_ = 0.0;           // a step back of ROS time, judged at the next stamped sample (checkRosTime)
-  double ros_step_forward_ = 0.0;   // a step forward of ROS time (against the steady clock), judged likewise
-  hm_clock_watch ros_watch_{};      // ROS time against the steady clock (wall time only: a forward step)
   double last_stamp_ = -1e300;      // the last sample's stamp pushed
   unsigned long time_jumps_ = 0;
   std::string last_jump_;
