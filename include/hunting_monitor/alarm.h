@@ -279,7 +279,8 @@ typedef struct {
   unsigned hold_waits;              /* what the release waits for: HM_HOLD_WAITS_* bits */
   hm_reason hold_no_data;           /* with HM_HOLD_WAITS_DATA, what is missing (HM_REASON_NO_ACCEL, NO_SPEED or
                                        BAD_SAMPLE_RATE: the level NO_DATA would have said); else HM_REASON_STARTUP */
-  double hunted_at_s;               /* when the oscillation met a criterion at hunted_at_kmh (NAN: none) */
+  double hunted_at_s;               /* when the oscillation met a criterion at hunted_at_kmh (after a restore: when its
+                                       memory started, state.h; NAN: none) */
   double time_s;                    /* the update's time [s] */
   double speed_kmh;                 /* the speed judged (the estimate's; 0 without a current one) */
 } hm_assessment;

@@ -641,9 +641,11 @@ static void hunted_bound(hm_alarm a, const hm_estimate *e, double now, hm_assess
  * with that cause, until the release conditions have held for release_s. 1 when it was released now (the level
  * then falls at once: the calm release_s was its hold, and min_hold_s more showed an ALARM neither latched nor held
  * with a criterion's reason that no longer held, issue #27). */
-static int latch(hm_alarm a, const hm_estimate *e, double now, hm_assessment *s, hm_level *target, hm_reason *reason) {
+static int latch(hm_alarm a, const hm_estimate *e, double now, hm_assessment *s, hm_level *target, hm_reason *reason,
+                 int kept) {
   int released = 0;
-  const int oscillation = *target == HM_LEVEL_ALARM && oscillation_reason(*reason);
+  /* (a level kept by the look-ahead carries the level's reason, the latch's cause: no criterion met now) */
+  const int oscillation = !kept && *target == HM_LEVEL_ALARM && oscillation_reason(*reason);
   if (a->latched || oscillation) release_conditions(a, e, s);
   if (oscillation) {
     if (!a->latched) a->latch_cause = *reason, a->latch_since_s = now;
@@ -694,7 +696,7 @@ hm_status hm_alarm_update(hm_alarm a, const hm_estimate *e, const hm_margin_esti
   s.hunted_at_kmh = s.hunted_at_s = NAN;
   hm_reason reason;
   hm_level target;
-  int released = 0;
+  int released = 0, kept = 0;
   if (!e->accel_valid || !e->speed_valid) {
     target = HM_LEVEL_NO_DATA;
     reason = !e->sample_rate_supported ? HM_REASON_BAD_SAMPLE_RATE
@@ -740,9 +742,9 @@ hm_status hm_alarm_update(hm_alarm a, const hm_estimate *e, const hm_margin_esti
       hm_estimate ahead = *e;
       ahead.speed_kmh += a->dvdt_kmh_s * HM_ALARM_LOWER_LOOKAHEAD_S;
       hm_reason r_ahead;
-      if (raw_level(a, &ahead, g, &s, a->level, &r_ahead) >= a->level) target = a->level, reason = a->reason;
+      if (raw_level(a, &ahead, g, &s, a->level, &r_ahead) >= a->level) target = a->level, reason = a->reason, kept = 1;
     }
-    released = latch(a, e, now, &s, &target, &reason);
+    released = latch(a, e, now, &s, &target, &reason, kept);
   }
   hold_numbers(a, now, &s);
   /* (with no data the latch is kept: nothing says the oscillation has gone) */

@@ -322,6 +322,39 @@ static void oscillation_alarm_latches(void) {
   HM_CHECK(s.level != HM_LEVEL_WARN && isnan(s.hunted_at_kmh), "901 s after the release: %s, hunted at %.1f",
            hm_level_name(s.level), s.hunted_at_kmh);
   hm_alarm_destroy(a);
+  /* accelerating while held (the review's case, issue #27): an identified 0.14 +- 0.001 (its interval 505-513 km/h),
+   * the r.m.s. criterion down to 480 km/h until 25 s, then 0.1 mm and 0.8 km/h/s from 480 km/h: held throughout (the
+   * speed never below the release speed, 477 km/h), the criterion last met at 25 s. The look-ahead that keeps a level
+   * while accelerating had handed the latch's cause back as if a criterion were met: held 0 with "sliding r.m.s.
+   * criterion exceeded" from 61.5 to 87.5 s and the last-met time advancing */
+  hm_margin_estimate g14 = identified();
+  g14.conicity = 0.14, g14.conicity_se = 0.001, g14.conicity_low = 0.138, g14.conicity_high = 0.142;
+  g14.hopf_model_kmh = hopf_closed_form(0.14);
+  g14.hopf_model_low_kmh = hopf_closed_form(0.142), g14.hopf_model_high_kmh = hopf_closed_form(0.138);
+  a = make_prior(0.0, 0.0);
+  hm_alarm_set_displacement_limit(a, 2.1e-3);
+  for (int k = 0; k < 300; ++k) {
+    e = estimate(505.0, 0.1e-3);
+    hm_alarm_update(a, &e, &g14, 0.1 * k, &s);
+  }
+  int held_all = 1, n_latched = 0;
+  double last_met_max = 0.0;
+  for (int k = 1; k <= 1500; ++k) {
+    const double tt = 0.1 * k, v = tt <= 10.0 ? 505.0 - 2.5 * tt : tt <= 20.0 ? 480.0 : 480.0 + 0.8 * (tt - 20.0);
+    const int crit = tt <= 25.0;
+    e = estimate(v, crit ? 2.5e-3 : 0.1e-3);
+    e.rms_exceeded = crit;
+    hm_alarm_update(a, &e, &g14, 30.0 + tt, &s);
+    if (tt > 25.05 && s.latched) {
+      ++n_latched;
+      held_all &= s.held && s.level == HM_LEVEL_ALARM;
+      last_met_max = fmax(last_met_max, s.hold_last_met_s);
+    }
+  }
+  HM_CHECK(n_latched > 1000 && held_all && last_met_max == 55.0,
+           "accelerating while held: %d latched statuses, held in all %d, last met at most %.1f s (55.0)", n_latched,
+           held_all, last_met_max);
+  hm_alarm_destroy(a);
   /* calm oscillation but the speed inside the Hopf interval: held */
   a = make();
   hm_alarm_set_displacement_limit(a, 2.1e-3);
