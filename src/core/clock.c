@@ -38,6 +38,12 @@ static void anchor(hm_clock *c, double d, double receipt_s) {
   c->last_mapped_s = -INFINITY;
 }
 
+/* Nothing was received for longer than the window (window_s and a block of receipt time): the window has nothing left
+ * to judge a sample against. */
+static int silent(const hm_clock *c, double receipt_s) {
+  return receipt_s - c->block_start_s >= c->cfg.window_s + c->cfg.window_s / HM_CLOCK_BLOCKS;
+}
+
 /* A stamp that continues the stamps used (not earlier than the last, at most max_step_s after it): a backlog's. */
 static int continues(const hm_clock *c, double stamp_s) {
   return isfinite(c->last_stamp_s) && stamp_s >= c->last_stamp_s && stamp_s - c->last_stamp_s <= c->cfg.max_step_s;
@@ -79,7 +85,7 @@ void hm_clock_shift(hm_clock *c, double delta_s) {
  * 20 s had anchored the offset on the backlog's first sample, 20 s late, and moved that line back by 20 s). */
 static void enter(hm_clock *c, double d, double receipt_s, int backlog) {
   const double block_s = c->cfg.window_s / HM_CLOCK_BLOCKS;
-  if (receipt_s - c->block_start_s >= c->cfg.window_s + block_s) {  /* silent for longer than the window */
+  if (silent(c, receipt_s)) {
     const double offset = c->offset_s, mapped = c->last_mapped_s;
     anchor(c, backlog ? fmin(d, offset) : d, receipt_s);
     c->last_mapped_s = mapped;
@@ -113,8 +119,7 @@ hm_status hm_clock_observe(hm_clock *c, double stamp_s, double receipt_s, hm_clo
   const double dev = d - c->offset_s;
   int chained = 1; /* the stamp continues the stamps used (a late one that does not is used, not chained on) */
   const int backlog = dev > c->cfg.max_step_s && continues(c, stamp_s);
-  if (!backlog && fabs(dev) > c->cfg.max_step_s &&
-      receipt_s - c->block_start_s >= c->cfg.window_s * (1.0 + 1.0 / HM_CLOCK_BLOCKS)) {
+  if (!backlog && fabs(dev) > c->cfg.max_step_s && silent(c, receipt_s)) {
     /* off the line after a silence longer than the window: a new line at once (a sensor rebooted while silent; the
      * window would have taken it in as the offset, the stamps gone back unseen: issue #27's review) */
     anchor(c, d, receipt_s);
