@@ -97,7 +97,10 @@ class MonitorRos {
   // the sensor's clock against ROS time, and time jumps
   hm_clock clock_{};
   double last_ros_time_ = 0.0;
-  double ros_step_ = 0.0;           // a step back of ROS time, judged at the next stamped sample (checkRosTime)
+  double ros_step_ = 0.0;           // a step back of ROS time, judged on the stamped samples after it (checkRosTime)
+  double ros_step_ref_ = 0.0;       // the highest stamp of the line when it was seen: stamps that go on from it decide
+                                    // "ROS time alone" only once they have gone on for kRosStepJudgeS
+  double stamp_high_ = -1e301;      // the highest stamp used on the current line
   double last_stamp_ = -1e300;      // the last sample's stamp pushed
   unsigned long time_jumps_ = 0;
   std::string last_jump_;
