@@ -284,12 +284,17 @@ void MonitorRos::pushAccel(double t, double a) {
 
 void MonitorRos::onAccelFloat(const std_msgs::Float64::ConstPtr& msg) {
   const ros::Time now = ros::Time::now();
+  if (now.isZero()) return;  // simulated time before its first /clock: no receipt time yet
   checkRosTime(now);
   pushAccel(now.toSec(), msg->data);  // receipt time: no stamp in a Float64
 }
 
 void MonitorRos::onAccelImu(const sensor_msgs::Imu::ConstPtr& msg) {
   const ros::Time now = ros::Time::now();
+  // simulated time before its first /clock has no receipt time: a stamped sample taken at 0 anchored the clock
+  // offset at -stamp, every later sample then late and the stream stale for the offset's 10 s window (timejump.test:
+  // "not monitoring at first", 1 run in 10)
+  if (now.isZero()) return;
   checkRosTime(now);
   const auto& a = msg->linear_acceleration;
   const double value = axis_ == 0 ? a.x : axis_ == 1 ? a.y : a.z;
@@ -332,7 +337,6 @@ void MonitorRos::onAccelImu(const sensor_msgs::Imu::ConstPtr& msg) {
     stamp_high_ = stamp;
     timeJumped(what, before - clock_.offset_s);  // the stamps moved by minus the offset's change
   }
-  last_stamp_ = stamp;
   stamp_high_ = std::max(stamp_high_, stamp);
   pushAccel(stamp, value);
 }

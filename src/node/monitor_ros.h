@@ -101,7 +101,6 @@ class MonitorRos {
   double ros_step_ref_ = 0.0;       // the highest stamp of the line when it was seen: stamps that go on from it decide
                                     // "ROS time alone" only once they have gone on for kRosStepJudgeS
   double stamp_high_ = -1e301;      // the highest stamp used on the current line
-  double last_stamp_ = -1e300;      // the last sample's stamp pushed
   unsigned long time_jumps_ = 0;
   std::string last_jump_;
   double last_jump_at_ = -1e300;
