@@ -9,9 +9,8 @@
  * its mode is valid, its speed varied by at most max_speed_spread_kmh, it is at min_speed_kmh or more, it does not
  * overlap the previous window used (so that the windows' errors are independent), and the model explains its decay
  * rate and frequency together (the inversion's misfit chi2, one degree of freedom, at most max_misfit_chi2: else the
- * window is a misfit, counted, and used for the model-free estimate only: its decay rate at its speed is still a
- * measurement, whatever the model says of its frequency; so is a window no conicity explains). Windows older than memory_s are forgotten (the wheels wear, the track
- * changes).
+ * window is a misfit, counted for model_mismatch below, and not used by either estimate). Windows older than memory_s
+ * are forgotten (the wheels wear, the track changes).
  * Change: a new window (committed or provisional) whose conicity differs from the mean of those held by more than
  * change_z of their combined standard errors means the conicity changed (a worn section of rail, other wheels after a
  * coupling): the windows held are dropped and the new one is kept (the evidence of the change; committed, also when
@@ -50,7 +49,12 @@
  * what is known (within change_z combined standard errors of the windows held or, without any, the prior's range to
  * interval_z of its error), or above it (its Hopf speed below what is known: the cautious
  * reading, which may lower the interval, alarm.h); else the window is not used (HM_WINDOW_AMBIGUOUS; the alarm says
- * so). A line at 14 Hz at 400 km/h reads as the mode at its Hopf speed with a conicity of 0.22 where the prior
+ * so). A narrow peak whose wavelength V / f was seen at another steady speed (narrow_peak_tracked, set by the monitor
+ * from track_lines.h) is a track line whatever the model says of it: never the mode; the reading beside it is used
+ * when what is known supports it (or it is the cautious reading), and otherwise the window is HM_WINDOW_TRACK_LINE,
+ * not used and not a misfit: the line's remains pull that reading toward the line (a 6.08 m slab's line at 12.8 Hz,
+ * 280 km/h, beside a mode of -8.45 1/s at 13.42 Hz read -5.5 at 12.8: the campaign's slab_1590, whose misfit verdicts,
+ * counted at every fit, had raised model_mismatch and a WARN 70 km/h below the Hopf speed). A line at 14 Hz at 400 km/h reads as the mode at its Hopf speed with a conicity of 0.22 where the prior
  * says 0.11-0.17: set aside when the mode beside it is found, ambiguous otherwise.
  * A window whose speed changed (a ramp) and whose peak moved with the speed as a track line does (modal.h's
  * speed_tracking, d ln f / d ln V between its halves, three standard errors above the model's hunting mode's at the
@@ -158,8 +162,11 @@ typedef enum {
                                (monitor.h) */
   HM_WINDOW_AMBIGUOUS = 9,  /* its narrow peak may be a line or the mode at its Hopf speed, and neither reading is
                                supported (below): not used */
-  HM_WINDOW_TRACKS_SPEED = 10 /* its peak moved with the speed as a track line does, not as the model's mode (below):
+  HM_WINDOW_TRACKS_SPEED = 10, /* its peak moved with the speed as a track line does, not as the model's mode (below):
                                  not used, and not a misfit */
+  HM_WINDOW_TRACK_LINE = 11   /* its narrow peak is a track line (its wavelength seen at another speed: track_lines.h)
+                                 and the reading beside it is not one the model explains with what is known: not
+                                 used, and not a misfit (the line's remains bias it) */
 } hm_window_verdict;
 
 /* A short English sentence for a verdict; never NULL. */

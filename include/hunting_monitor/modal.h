@@ -141,6 +141,16 @@ typedef struct {
   int narrow_peak;
   double narrow_peak_hz, narrow_peak_mps2;
   hm_mode_reading line_reading;
+  /* line_reading again with the line's skirt left out too where the line lies inside that reading's peak (+-0.5 Hz
+   * about it, lines.h's background_halfwidth_hz: a strong line on a vehicle that is not linear keeps a skirt the
+   * subtraction of one sinusoid leaves); line_reading itself where it does not. For a peak known for a line only
+   * (narrow_peak_tracked: a narrow mode's own core is no skirt) */
+  hm_mode_reading line_reading_wide;
+  /* set by the caller that tracks lines across windows (monitor.h, track_lines.h), 0 from the fit: the narrow peak's
+   * wavelength V / f [m] in a window at one steady speed, and 1 when that wavelength was seen at another steady speed
+   * (a track line, not the mode) */
+  int narrow_peak_tracked;
+  double narrow_peak_wavelength_m;
   /* how the mode's peak moved with the speed (order tracking, with the speed's change over the window given): one
    * pair fitted to each half of the last window_s, d ln f / d ln V = ln(f2 / f1) / ln(V2 / V1) and its standard error from
    * the halves' frequency errors. A track line's frequency is V / L (1); the model's hunting frequency changes far

@@ -21,6 +21,11 @@
  * during which an update saw a criterion met (hunting or its onset: sliding r.m.s., peaks, displacement) is not given
  * to the margin (HM_WINDOW_NONLINEAR): a hunting limit cycle is not the linear mode, and its "decay rate" of about
  * zero would read as a Hopf speed at the current speed (on the independent simulator it once read 168 km/h).
+ * The track's lines (track_lines.h): each fit whose window was at least half at one speed (the chunks' means within
+ * half the wavelength tolerance of the newest's) gives its lone lines, its narrow peak and its comb's fundamental, at
+ * that speed, to the record of lines; its narrow peak, if its wavelength was seen at another speed, is marked a track
+ * line (mode.narrow_peak_tracked) before the margin judges the window. The record is forgotten with the margin's
+ * windows (a reset) and moved with them (a known time step); it is not in the state record (a restart relearns it).
  * No allocation after create.
  */
 #ifndef HUNTING_MONITOR_MONITOR_H
@@ -35,6 +40,7 @@
 #include "hunting_monitor/model.h"
 #include "hunting_monitor/status.h"
 #include "hunting_monitor/tables.h"
+#include "hunting_monitor/track_lines.h"
 
 #ifdef __cplusplus
 extern "C" {
@@ -45,6 +51,7 @@ typedef struct {
   hm_modal_config modal;
   hm_margin_config margin;
   hm_alarm_config alarm;
+  hm_track_lines_config track_lines; /* lines told from the mode by their wavelength across speeds */
   size_t table_n_conicity; /* conicities of a table computed at start (when none is given) */
   struct {
     int refine;              /* 1: want the exact family where the interpolation would err more than below */

@@ -124,6 +124,9 @@ static void write_line(const hm_monitor_status *st, double t, const read_counts 
   jw_number(&w, "mode_speed_tracking_se", md->speed_tracking_se);
   jw_bool(&w, "narrow_peak", md->narrow_peak);
   jw_number(&w, "narrow_peak_hz", md->narrow_peak ? md->narrow_peak_hz : NAN);
+  jw_number(&w, "narrow_peak_wavelength_m",
+            md->narrow_peak && md->narrow_peak_wavelength_m > 0.0 ? md->narrow_peak_wavelength_m : NAN);
+  jw_bool(&w, "narrow_peak_tracked", md->narrow_peak_tracked);
   jw_string(&w, "narrow_peak_taken_for", hm_narrow_verdict_text(g->narrow));
   jw_int(&w, "windows_used", (long)g->n_windows);
   /* the margin: model-based and model-free Hopf speeds */

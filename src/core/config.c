@@ -310,6 +310,7 @@ typedef struct {
 #define MOD(f, t) {#f, t, offsetof(hm_monitor_config, modal) + offsetof(hm_modal_config, f)}
 #define MAR(f, t) {#f, t, offsetof(hm_monitor_config, margin) + offsetof(hm_margin_config, f)}
 #define ALM(f, t) {#f, t, offsetof(hm_monitor_config, alarm) + offsetof(hm_alarm_config, f)}
+#define TRK(f, t) {#f, t, offsetof(hm_monitor_config, track_lines) + offsetof(hm_track_lines_config, f)}
 #define TAB(f, t) {#f, t, offsetof(hm_monitor_config, table.f)}
 
 static const settings_field estimator_fields[] = {
@@ -354,6 +355,10 @@ static const settings_field alarm_fields[] = {
     ALM(blind_fraction, FIELD_DOUBLE),
 };
 
+static const settings_field track_lines_fields[] = {
+    TRK(wavelength_tol_rel, FIELD_DOUBLE), TRK(min_speed_change_rel, FIELD_DOUBLE), TRK(memory_s, FIELD_DOUBLE),
+};
+
 static const settings_field table_fields[] = {
     TAB(refine, FIELD_BOOL), TAB(tolerance_kmh, FIELD_DOUBLE), TAB(tolerance_m, FIELD_DOUBLE),
     TAB(max_curves, FIELD_UNSIGNED),
@@ -367,6 +372,7 @@ static const struct {
                 {"modal", modal_fields, sizeof modal_fields / sizeof modal_fields[0]},
                 {"margin", margin_fields, sizeof margin_fields / sizeof margin_fields[0]},
                 {"alarm", alarm_fields, sizeof alarm_fields / sizeof alarm_fields[0]},
+                {"track_lines", track_lines_fields, sizeof track_lines_fields / sizeof track_lines_fields[0]},
                 {"table", table_fields, sizeof table_fields / sizeof table_fields[0]}};
 
 /* One key's value into the field at base + f->offset. */

@@ -52,6 +52,8 @@ const char *hm_window_verdict_text(hm_window_verdict v) {
     case HM_WINDOW_AMBIGUOUS:
       return "a narrow peak: a line, or the mode at its Hopf speed at a conicity nothing else supports: not used";
     case HM_WINDOW_TRACKS_SPEED: return "its peak moved with the speed like a track line, not like the mode: not used";
+    case HM_WINDOW_TRACK_LINE:
+      return "its narrow peak is a track line seen at another speed, and the mode beside it is not explained: not used";
   }
   return "?";
 }
@@ -302,18 +304,22 @@ static hm_window_verdict prepare(const hm_margin m, double t_end, double speed_k
       return HM_WINDOW_TRACKS_SPEED;
   }
   if (!mode->narrow_peak) return v;
-  if (v == HM_WINDOW_USED && supports_narrow(m, w)) return *narrow = HM_NARROW_MODE, v;
+  const int tracked = mode->narrow_peak_tracked; /* a track line by its wavelength across speeds: never the mode */
+  if (!tracked && v == HM_WINDOW_USED && supports_narrow(m, w)) return *narrow = HM_NARROW_MODE, v;
   window wl;
-  const hm_window_verdict vl =
-      prepare_reading(m, t_end, speed_kmh, spread_kmh, mode->window_s, &mode->line_reading, &wl);
+  const hm_window_verdict vl = prepare_reading(m, t_end, speed_kmh, spread_kmh, mode->window_s,
+                                               tracked ? &mode->line_reading_wide : &mode->line_reading, &wl);
   const int impossible = v == HM_WINDOW_MISFIT || v == HM_WINDOW_NO_INVERSION;
   const int beside = primary.poles == 2 || fabs(mode->line_reading.frequency_hz - primary.frequency_hz) > 1.0;
   /* the mode beside it, where what is known supports it, or where it is the cautious reading (wheels worn beyond the
    * prior: it lowers the interval, alarm.h) */
-  if (vl == HM_WINDOW_USED && (impossible || beside) && (supported(m, &wl) || cautious(m, &wl))) {
+  if (vl == HM_WINDOW_USED && (impossible || beside || tracked) && (supported(m, &wl) || cautious(m, &wl))) {
     *w = wl;
     return *narrow = HM_NARROW_LINE, vl;
   }
+  /* a known line and a reading beside it that what is known does not support: the line's remains (its skirt beside
+   * the bins left out) pull that reading toward it; no evidence against the model */
+  if (tracked) return *narrow = HM_NARROW_LINE, HM_WINDOW_TRACK_LINE;
   if (impossible && vl != HM_WINDOW_USED) return *narrow = HM_NARROW_LINE, vl; /* a line and no mode beside it */
   if (v != HM_WINDOW_USED && v != HM_WINDOW_MISFIT && v != HM_WINDOW_NO_INVERSION) return v; /* not for this reason */
   return *narrow = HM_NARROW_AMBIGUOUS, HM_WINDOW_AMBIGUOUS;

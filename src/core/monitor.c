@@ -21,6 +21,7 @@ struct hm_monitor_s {
   hm_modal modal;
   hm_margin margin;
   hm_alarm alarm;
+  hm_track_lines lines;          /* the track's lines seen at steady speeds (track_lines.h) */
   int modal_ok;                  /* the identification can run at the current rate */
   unsigned long restarts;        /* the estimator's, as last seen */
   double rate_hz;
@@ -45,6 +46,7 @@ void hm_monitor_config_default(hm_monitor_config *c) {
   hm_modal_config_default(&c->modal);
   hm_margin_config_default(&c->margin);
   hm_alarm_config_default(&c->alarm);
+  hm_track_lines_config_default(&c->track_lines);
   c->table_n_conicity = 36;
   c->table.refine = 1;
   c->table.tolerance_kmh = 0.05;
@@ -67,6 +69,7 @@ hm_status hm_monitor_config_validate(const hm_monitor_config *c, char *why, size
   if (st == HM_OK) st = prefixed(hm_modal_config_validate(&c->modal, why, len), "modal", why, len);
   if (st == HM_OK) st = prefixed(hm_margin_config_validate(&c->margin, why, len), "margin", why, len);
   if (st == HM_OK) st = prefixed(hm_alarm_config_validate(&c->alarm, why, len), "alarm", why, len);
+  if (st == HM_OK) st = hm_track_lines_config_validate(&c->track_lines, why, len); /* "track_lines." prefixed */
   if (st == HM_OK && (c->table_n_conicity < 2 || c->table_n_conicity > 1000)) {
     if (why && len) snprintf(why, len, "table_n_conicity: must be 2..1000 (got %zu)", c->table_n_conicity);
     st = HM_EDOMAIN;
@@ -138,6 +141,7 @@ hm_status hm_monitor_create_parallel(const hm_monitor_config *cfg, const hm_vehi
   if (st == HM_OK) st = hm_modal_create(&cfg->modal, cfg->estimator.sample_rate_hz, &m->modal, why, len);
   if (st == HM_OK) st = hm_margin_create(&cfg->margin, veh, &m->margin, why, len);
   if (st == HM_OK) st = hm_alarm_create(&cfg->alarm, veh, table, &m->alarm, why, len);
+  if (st == HM_OK) st = hm_track_lines_init(&m->lines, &cfg->track_lines, why, len);
   if (st != HM_OK) {
     hm_monitor_destroy(m);
     return st;
@@ -185,6 +189,7 @@ void hm_monitor_reset(hm_monitor m) {
   if (!m) return;
   restart_input(m);
   hm_margin_reset(m->margin); /* its windows' times are on the old time line */
+  hm_track_lines_clear(&m->lines);
   m->large_at = -INFINITY;
   hm_alarm_restart(m->alarm); /* a held ALARM stays held: a latch carries no times that matter */
 }
@@ -197,6 +202,7 @@ void hm_monitor_time_jump(hm_monitor m, double delta_s) {
   }
   restart_input(m);
   hm_margin_shift_time(m->margin, delta_s);
+  hm_track_lines_shift_time(&m->lines, delta_s);
   m->large_at += delta_s;
   hm_alarm_shift_time(m->alarm, delta_s);
 }
@@ -213,6 +219,37 @@ static double halves_ratio(const hm_monitor m, double window_s) {
   }
   if (!(n[0] > 0.0 && n[1] > 0.0 && sum[1] > 0.0)) return 0.0;
   return (sum[0] / n[0]) / (sum[1] / n[1]);
+}
+
+/* The speed held for most of the last window_s [km/h]: the chunks' mean within rel / 2 of the newest chunk's, when
+ * they make at least half of it (a line's peak is at that speed's V / L, whatever the rest of the window did); 0 if
+ * none held so long. */
+static double held_speed(const hm_monitor m, double window_s, double rel) {
+  double t = 0.0, held_s = 0.0, sum = 0.0, n = 0.0, ref = NAN;
+  for (size_t k = 0; k < m->n_chunks && t < window_s - 1e-9; ++k) {
+    const speed_chunk *c = &m->chunks[(m->chunk_head + m->n_chunks_cap - 1 - k) % m->n_chunks_cap];
+    t += c->duration_s;
+    if (!(c->n > 0.0)) continue;
+    const double v = c->sum / c->n;
+    if (!isfinite(ref)) ref = v;
+    if (fabs(v - ref) <= 0.5 * rel * ref) held_s += c->duration_s, sum += c->sum, n += c->n;
+  }
+  return n > 0.0 && held_s >= 0.5 * window_s ? sum / n : 0.0;
+}
+
+/* The lines of a window fitted at one steady speed v [km/h]: whether its narrow peak is a line seen at another speed
+ * (into mode's narrow_peak_tracked, with narrow_peak_wavelength_m), then each of its lines kept (track_lines.h). */
+static void track_lines_of(hm_monitor m, double t, double v, hm_mode_estimate *mode) {
+  hm_track_line seen;
+  if (mode->narrow_peak) {
+    mode->narrow_peak_wavelength_m = v / 3.6 / mode->narrow_peak_hz;
+    mode->narrow_peak_tracked = hm_track_lines_match(&m->lines, t, v, mode->narrow_peak_hz, &seen);
+  }
+  if (mode->narrow_peak) hm_track_lines_observe(&m->lines, t, v, mode->narrow_peak_hz, mode->narrow_peak_mps2, 0);
+  for (unsigned k = 0; k < mode->lone_lines && k < HM_MODAL_MAX_LONE; ++k)
+    hm_track_lines_observe(&m->lines, t, v, mode->lone_line_hz[k], mode->lone_line_mps2[k], 0);
+  if (mode->lines_found)
+    hm_track_lines_observe(&m->lines, t, v, mode->line_fundamental_hz, 0.0, 1);
 }
 
 /* A fit of the identification. At a steady speed (the newest stretch whose speed varied by at most the margin's
@@ -264,6 +301,11 @@ static void fit(hm_monitor m, double t) {
   m->mode = e;
   m->mode_speed = steady.n > 0.0 ? steady.sum / steady.n : m->speed_kmh;
   m->mode_spread = is_steady ? steady.max - steady.min : INFINITY;
+  /* the track's lines: a window at one steady speed (its speed's range within the wavelength tolerance) tells their
+   * wavelengths; a narrow peak whose wavelength was seen at another speed is a line (track_lines.h) */
+  const double v_held = held_speed(m, e.window_s, m->cfg.track_lines.wavelength_tol_rel);
+  if (v_held > 0.0) track_lines_of(m, t, v_held, &e);
+  m->mode = e;
   m->verdict = is_steady ? HM_WINDOW_OVERLAPS : HM_WINDOW_SPEED_VARIED;
   if (!for_margin) return;
   if (t - e.window_s <= m->large_at) { /* a large oscillation in the window: not the linear mode */
@@ -282,7 +324,8 @@ static void fit(hm_monitor m, double t) {
   if (m->verdict == HM_WINDOW_CHANGE) m->committed_until = t; /* the change's window is committed (margin.h) */
   /* a narrow peak the margin took for a line: the mode shown is the one beside it */
   if (m->mode.narrow_peak && hm_margin_last_narrow(m->margin) == HM_NARROW_LINE) {
-    hm_mode_estimate_use_reading(&m->mode, &m->mode.line_reading);
+    hm_mode_estimate_use_reading(&m->mode, m->mode.narrow_peak_tracked ? &m->mode.line_reading_wide
+                                                                       : &m->mode.line_reading);
     m->mode.speed_tracking = m->mode.speed_tracking_se = NAN; /* measured on the narrow peak's reading, not this one */
   }
 }

@@ -116,7 +116,7 @@ bool MonitorRos::loadParameters() {
     return false;
   }
   hm_monitor_config_default(&cfg_);
-  const std::string monitor_yaml = sectionsAsYaml(pnh_, {"estimator", "modal", "margin", "alarm", "table"});
+  const std::string monitor_yaml = sectionsAsYaml(pnh_, {"estimator", "modal", "margin", "track_lines", "alarm", "table"});
   if (hm_config_parse_monitor(monitor_yaml.c_str(), monitor_yaml.size(), "~ (monitor parameters)", &cfg_, err,
                               sizeof err) != HM_OK) {
     ROS_FATAL("hunting_monitor: %s", err);
@@ -434,6 +434,8 @@ void MonitorRos::onTimer(const ros::TimerEvent&) {
   m.narrow_peak_hz = md.narrow_peak ? finite(md.narrow_peak_hz) : 0.0;
   m.narrow_peak_verdict = static_cast<uint8_t>(g.narrow);
   m.narrow_peak_verdict_text = hm_narrow_verdict_text(g.narrow);
+  m.narrow_peak_wavelength_m = md.narrow_peak ? finite(md.narrow_peak_wavelength_m) : 0.0;
+  m.narrow_peak_tracked = md.narrow_peak && md.narrow_peak_tracked;
   m.speed_tracking_measured = std::isfinite(md.speed_tracking);
   m.mode_speed_tracking = finite(md.speed_tracking);
   m.mode_speed_tracking_se = finite(md.speed_tracking_se);

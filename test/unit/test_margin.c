@@ -277,7 +277,27 @@ static hm_mode_estimate narrow_at(double f_hz, double line_lambda, double v, int
   hunting_eigenvalue(line_lambda, v, &m.line_reading.decay_rate_1_s, &m.line_reading.frequency_hz);
   m.line_reading.decay_rate_se_1_s = 0.8;
   m.line_reading.frequency_se_hz = 0.1;
+  m.line_reading_wide = m.line_reading; /* the line outside the mode's peak: no skirt left out (modal.h) */
   return m;
+}
+
+/* Windows of 0.1358 held at 440, 470 and 500 km/h (m reset, the prior set), and a narrow peak at the Hopf frequency
+ * of 516 km/h, 1.6 km/h below the Hopf speed (the eigenvalues): its decay rate and frequency there, the line
+ * reading (valid when line_valid) the mode at 480 km/h beside it, two pairs. */
+static hm_mode_estimate toward_hopf(hm_margin m, int line_valid) {
+  hm_window_verdict v;
+  hm_margin_reset(m);
+  hm_margin_set_prior(m, PRIOR_LO, PRIOR_HI);
+  const double speeds[] = {440.0, 470.0, 500.0};
+  for (int k = 0; k < 3; ++k) {
+    const hm_mode_estimate w = mode_at(0.1358, speeds[k], 0.3, 0.05);
+    hm_margin_add_window(m, 40.0 * (k + 1), speeds[k], 2.0, &w, &v);
+  }
+  double s516, f516;
+  hunting_eigenvalue(0.1358, 516.0, &s516, &f516);
+  hm_mode_estimate e = narrow_at(f516, 0.1358, 480.0, line_valid, 1);
+  e.decay_rate_1_s = s516;
+  return e;
 }
 
 /* A narrow peak is the mode near its Hopf speed when the model produces it and what is known supports its conicity
@@ -328,16 +348,7 @@ static void narrow_peaks(void) {
   HM_CHECK(v == HM_WINDOW_USED && g.narrow == HM_NARROW_LINE, "9 Hz: %d %d", v, g.narrow);
   HM_CHECK_DELTA(g.conicity, 0.1358, 1e-3, "the mode beside the 9 Hz line");
   /* approaching the Hopf speed: windows of 0.1358 held, then a narrow peak at its Hopf frequency 1.6 km/h below it */
-  hm_margin_reset(m);
-  const double speeds[] = {440.0, 470.0, 500.0};
-  for (int k = 0; k < 3; ++k) {
-    const hm_mode_estimate w = mode_at(0.1358, speeds[k], 0.3, 0.05);
-    hm_margin_add_window(m, 40.0 * (k + 1), speeds[k], 2.0, &w, &v);
-  }
-  double s516, f516;
-  hunting_eigenvalue(0.1358, 516.0, &s516, &f516);
-  e = narrow_at(f516, 0.1358, 480.0, 1, 1);
-  e.decay_rate_1_s = s516;
+  e = toward_hopf(m, 1);
   hm_margin_add_window(m, 160.0, 516.0, 1.0, &e, &v);
   hm_margin_read(m, 160.0, &g);
   HM_CHECK(v == HM_WINDOW_USED && g.narrow == HM_NARROW_MODE && g.n_windows == 4, "near the Hopf speed: %d %d", v,
@@ -358,6 +369,62 @@ static void narrow_peaks(void) {
   hm_margin_read(m, 80.0, &g);
   HM_CHECK(v == HM_WINDOW_AMBIGUOUS && g.narrow == HM_NARROW_AMBIGUOUS && g.n_windows == 1,
            "a narrow peak beside a vague window: verdict %d, narrow %d, %u windows", v, g.narrow, g.n_windows);
+  hm_margin_destroy(m);
+}
+
+/* A narrow peak known for a track line (its wavelength seen at another speed: track_lines.h, narrow_peak_tracked) is
+ * never the mode, and a reading beside it the model does not explain (a line's skirt pulls it: slab_1590 of the
+ * campaign, -5.5 1/s at 12.8 Hz at 280 km/h where the model puts -8.5 at 13.4) is not a misfit: HM_WINDOW_TRACK_LINE,
+ * no misfit counted, no mismatch after any number of them; the same windows untracked are misfits, two of them a
+ * mismatch. The same tracked peak with the mode of the prior's conicity beside it: that mode used. A tracked peak at
+ * the Hopf frequency 1.6 km/h below the Hopf speed, which untracked is the mode (narrow_peaks), is not taken for it.
+ * References: the model's eigenvalues (hunting_eigenvalue), the closed-form critical conicity. */
+static void tracked_narrow_peaks(void) {
+  hm_margin_config c;
+  hm_margin_config_default(&c);
+  hm_margin m = NULL;
+  hm_margin_create(&c, &vehicle, &m, NULL, 0);
+  hm_margin_set_prior(m, PRIOR_LO, PRIOR_HI);
+  hm_window_verdict v;
+  hm_margin_estimate g;
+  /* a line at 9 Hz at 400 km/h (the model's hunting mode is at 13.7 Hz there: the line is no mode); the reading
+   * beside it 0.6 Hz below the model's frequency for 0.1358 with its decay rate halved (the skirt) */
+  for (int tracked = 1; tracked >= 0; --tracked) {
+    hm_margin_reset(m);
+    hm_margin_set_prior(m, PRIOR_LO, PRIOR_HI);
+    for (int k = 1; k <= 3; ++k) {
+      hm_mode_estimate e = narrow_at(9.0, 0.1358, 400.0, 1, 0);
+      e.narrow_peak_tracked = tracked;
+      e.line_reading.frequency_hz -= 0.6; /* pulled toward the line: the model cannot produce it with that decay rate */
+      e.line_reading.decay_rate_1_s *= 0.5;
+      e.line_reading.decay_rate_se_1_s = 0.2;
+      e.line_reading.frequency_se_hz = 0.02;
+      e.line_reading_wide = e.line_reading;
+      hm_margin_add_window(m, 40.0 * k, 400.0, 1.0, &e, &v);
+      HM_CHECK(v == (tracked ? HM_WINDOW_TRACK_LINE : HM_WINDOW_MISFIT), "tracked %d, window %d: verdict %d", tracked,
+               k, v);
+    }
+    hm_margin_read(m, 120.0, &g);
+    HM_CHECK(g.n_misfits == (tracked ? 0u : 3u) && g.model_mismatch == !tracked && g.n_windows == 0,
+             "tracked %d: %u misfits, mismatch %d, %u windows", tracked, g.n_misfits, g.model_mismatch, g.n_windows);
+  }
+  /* the mode of 0.1358 beside a tracked line at one pair: used (untracked, a single pair's flanks are ambiguous) */
+  hm_margin_reset(m);
+  hm_margin_set_prior(m, PRIOR_LO, PRIOR_HI);
+  hm_mode_estimate e = narrow_at(14.0, 0.1358, 400.0, 1, 0);
+  e.narrow_peak_tracked = 1;
+  hm_margin_add_window(m, 40.0, 400.0, 1.0, &e, &v);
+  hm_margin_read(m, 40.0, &g);
+  HM_CHECK(v == HM_WINDOW_USED && g.narrow == HM_NARROW_LINE && g.n_windows == 1, "beside a tracked line: %d %d", v,
+           g.narrow);
+  HM_CHECK_DELTA(g.conicity, 0.1358, 1e-3, "the mode beside the tracked line");
+  /* near the Hopf speed: the narrow_peaks case, tracked */
+  e = toward_hopf(m, 0);
+  e.narrow_peak_tracked = 1;
+  hm_margin_add_window(m, 160.0, 516.0, 1.0, &e, &v);
+  hm_margin_read(m, 160.0, &g);
+  HM_CHECK(v == HM_WINDOW_TRACK_LINE && g.narrow == HM_NARROW_LINE && g.n_windows == 3 && g.n_misfits == 0,
+           "a tracked line at the Hopf frequency: verdict %d, narrow %d, %u windows", v, g.narrow, g.n_windows);
   hm_margin_destroy(m);
 }
 
@@ -428,6 +495,7 @@ static void estimates_outside_the_prior(void) {
 int main(void) {
   hm_vehicle_default(&vehicle);
   HM_RUN(narrow_peaks);
+  HM_RUN(tracked_narrow_peaks);
   HM_RUN(peaks_that_move_with_the_speed);
   HM_RUN(estimates_outside_the_prior);
   HM_RUN(inversion_recovers_the_conicity);
