@@ -41,7 +41,7 @@ struct hm_modal_s {
   unsigned char *excluded;     /* the bins of a comb of lines; after it, those set aside before a narrow peak's */
   unsigned char *set_aside;    /* the comb's and the lone lines' */
   hm_lines lines;
-  warm_start warm[2];          /* the window's reading, the line reading */
+  warm_start warm[3];          /* the window's reading, the line reading, the line reading without the skirt */
 };
 
 void hm_modal_config_default(hm_modal_config *c) {
@@ -190,7 +190,7 @@ void hm_modal_reset(hm_modal m) {
   hm_biquad_clear(&m->lp[1]);
   m->phase = 0;
   m->head = m->n_in = m->since_fit = 0;
-  for (int k = 0; k < 2; ++k) {
+  for (int k = 0; k < 3; ++k) {
     m->warm[k].have1 = m->warm[k].have2 = 0;
     m->warm[k].since_split = HM_MODAL_SPLIT_EVERY - 1; /* the first fit tries the splits */
   }
@@ -730,9 +730,9 @@ hm_status hm_modal_fit(hm_modal m, double max_window_s, double speed_spread_rel,
      * flanks of a bogie's mode at -0.6 1/s read -5.5) */
     if (ok && isfinite(r.line_reading.decay_rate_1_s) && in_peak(&g, &r.line_reading, r.narrow_peak_hz) &&
         skirt_aside(m, &g, r.narrow_peak_hz) > 0) {
-      warm_start w = m->warm[1]; /* the main-lobe reading's warm start is kept for the next fit */
+      if (!m->warm[2].have1) m->warm[2] = m->warm[1]; /* from the main-lobe reading's, then its own */
       nb_l = load_bins(m, &g, m->set_aside, &scale);
-      if (nb_l < 4 * HM_WHITTLE_NP2 || !fit_reading(m, &w, &g, nb_l, &r.line_reading_wide, th_l, &poles_l))
+      if (nb_l < 4 * HM_WHITTLE_NP2 || !fit_reading(m, &m->warm[2], &g, nb_l, &r.line_reading_wide, th_l, &poles_l))
         memset(&r.line_reading_wide, 0, sizeof r.line_reading_wide);
     }
   }
