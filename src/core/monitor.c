@@ -240,12 +240,11 @@ static double held_speed(const hm_monitor m, double window_s, double rel) {
 /* The lines of a window fitted at one steady speed v [km/h]: whether its narrow peak is a line seen at another speed
  * (into mode's narrow_peak_tracked, with narrow_peak_wavelength_m), then each of its lines kept (track_lines.h). */
 static void track_lines_of(hm_monitor m, double t, double v, hm_mode_estimate *mode) {
-  hm_track_line seen;
-  if (mode->narrow_peak) {
-    mode->narrow_peak_wavelength_m = v / 3.6 / mode->narrow_peak_hz;
-    mode->narrow_peak_tracked = hm_track_lines_match(&m->lines, t, v, mode->narrow_peak_hz, &seen);
+  if (mode->narrow_peak) { /* matched before it is kept: only another speed's sight of it counts */
+    mode->narrow_peak_wavelength_m = hm_mps_from_kmh(v) / mode->narrow_peak_hz;
+    mode->narrow_peak_tracked = hm_track_lines_match(&m->lines, t, v, mode->narrow_peak_hz, NULL);
+    hm_track_lines_observe(&m->lines, t, v, mode->narrow_peak_hz, mode->narrow_peak_mps2, 0);
   }
-  if (mode->narrow_peak) hm_track_lines_observe(&m->lines, t, v, mode->narrow_peak_hz, mode->narrow_peak_mps2, 0);
   for (unsigned k = 0; k < mode->lone_lines && k < HM_MODAL_MAX_LONE; ++k)
     hm_track_lines_observe(&m->lines, t, v, mode->lone_line_hz[k], mode->lone_line_mps2[k], 0);
   if (mode->lines_found)
@@ -298,11 +297,10 @@ static void fit(hm_monitor m, double t) {
     m->mode.valid = 0;
     return;
   }
-  m->mode = e;
   m->mode_speed = steady.n > 0.0 ? steady.sum / steady.n : m->speed_kmh;
   m->mode_spread = is_steady ? steady.max - steady.min : INFINITY;
-  /* the track's lines: a window at one steady speed (its speed's range within the wavelength tolerance) tells their
-   * wavelengths; a narrow peak whose wavelength was seen at another speed is a line (track_lines.h) */
+  /* the track's lines: a window at least half at one speed (held_speed) tells their wavelengths; a narrow peak whose
+   * wavelength was seen at another speed is a line (track_lines.h) */
   const double v_held = held_speed(m, e.window_s, m->cfg.track_lines.wavelength_tol_rel);
   if (v_held > 0.0) track_lines_of(m, t, v_held, &e);
   m->mode = e;

@@ -1,12 +1,11 @@
 /* Track lines by their wavelength across speeds (track_lines.h). */
 #include "hunting_monitor/track_lines.h"
 
+#include "hunting_monitor/linear.h"
+
 #include <math.h>
 #include <stdio.h>
 #include <string.h>
-
-/* km/h over Hz into metres */
-#define KMH_HZ_TO_M (1.0 / 3.6)
 
 void hm_track_lines_config_default(hm_track_lines_config *cfg) {
   if (!cfg) return;
@@ -70,7 +69,7 @@ hm_status hm_track_lines_observe(hm_track_lines *t, double now_s, double speed_k
   if (!t || !isfinite(now_s) || !positive(speed_kmh) || !positive(frequency_hz) || !isfinite(level_mps2) ||
       level_mps2 < 0.0)
     return HM_EINVAL;
-  const hm_track_line o = {speed_kmh * KMH_HZ_TO_M / frequency_hz, speed_kmh, frequency_hz, level_mps2, now_s,
+  const hm_track_line o = {hm_mps_from_kmh(speed_kmh) / frequency_hz, speed_kmh, frequency_hz, level_mps2, now_s,
                            comb != 0};
   const double same_speed = 0.1 * t->cfg.min_speed_change_rel;
   size_t slot = t->n, oldest = 0;
@@ -92,7 +91,7 @@ hm_status hm_track_lines_observe(hm_track_lines *t, double now_s, double speed_k
 int hm_track_lines_match(const hm_track_lines *t, double now_s, double speed_kmh, double frequency_hz,
                          hm_track_line *out) {
   if (!t || !isfinite(now_s) || !positive(speed_kmh) || !positive(frequency_hz)) return 0;
-  const double wavelength = speed_kmh * KMH_HZ_TO_M / frequency_hz;
+  const double wavelength = hm_mps_from_kmh(speed_kmh) / frequency_hz;
   const hm_track_line *best = NULL;
   for (size_t k = 0; k < t->n; ++k) {
     const hm_track_line *o = &t->obs[k];
