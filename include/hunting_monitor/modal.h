@@ -18,6 +18,11 @@
  *    less damped pair is the one pair's peak (inside its width, its top, above the other pair), so that a chance bump
  *    is not a mode. The hunting mode is the less damped pair: averaged with a broad resonance at its frequency a
  *    single pair reads -2.5 1/s for a mode of -0.56 (issue #26).
+ *  - Track lines are taken out in distance first where the window's speed moved them (order_lines.h: a line that
+ *    swept many bins stands nowhere above its background, yet lies on the mode's peak; sharper in distance than in
+ *    time, it is subtracted from the samples at its phase in distance). A reading as narrow as a line with such a
+ *    line taken out inside its peak (its residue, or the mode near its Hopf speed) is the narrow-peak question below,
+ *    its line fitted at the peak's strongest bin.
  *  - Lines are not the mode (issues #18, #26). A comb of lines at multiples of V / L (rail joints, bridge spans,
  *    slabs; lines.h, searched over 2.5 Hz to 0.3 of the decimated rate, two teeth where only two fit) is reported and
  *    its bins are left out. A lone candidate line is a line when a harmonic F test says so (one sinusoid explains its
@@ -130,6 +135,12 @@ typedef struct {
   double line_strongest_hz;    /* its strongest line and that line's acceleration amplitude [m/s^2] */
   double line_strongest_mps2;
   double band_excluded_fraction; /* of the band's bins left out of the fit */
+  /* track lines taken out of the window's samples in distance before anything else (order_lines.h; only where the
+   * window's speed moved a line at band_high_hz by more than two bins and every sample's speed was given,
+   * hm_modal_set_speed): how many, and the strongest's wavelength [m], frequency at the window's mean speed [Hz] and
+   * amplitude [m/s^2] */
+  unsigned order_lines;
+  double order_line_wavelength_m, order_line_hz, order_line_mps2;
   /* lone lines in the band (candidates of lines.h on no comb) that the mode's fit does not explain: left out of the
    * fit, strongest first, with their acceleration amplitudes */
   unsigned lone_lines;
@@ -199,6 +210,9 @@ hm_status hm_modal_set_rate(hm_modal m, double sample_rate_hz);
 
 /* One acceleration sample [m/s^2] at the input rate (finite: the caller validates). */
 void hm_modal_push(hm_modal m, double accel_mps2);
+/* The speed [m/s] from now on, kept with each sample (the track lines' order tracking, order_lines.h); not finite
+ * or not positive: unknown (the default, and after a reset). */
+void hm_modal_set_speed(hm_modal m, double v_mps);
 /* 1 when enough new data for a fit is in (fit_interval_s since the last one, min_window_s in all). */
 int hm_modal_fit_due(const hm_modal m);
 /* Fit the newest max_window_s of the window (at most window_s; the caller passes less when only the newest part was

@@ -120,6 +120,10 @@ static void write_line(const hm_monitor_status *st, double t, const read_counts 
   jw_number(&w, "lone_line_mps2", md->lone_lines ? md->lone_line_mps2[0] : NAN);
   jw_number(&w, "lone_line_wavelength_m",
             md->lone_lines && md->lone_line_hz[0] > 0.0 ? hm_mps_from_kmh(st->mode_speed_kmh) / md->lone_line_hz[0] : NAN);
+  jw_int(&w, "order_lines", (long)md->order_lines);
+  jw_number(&w, "order_line_wavelength_m", md->order_lines ? md->order_line_wavelength_m : NAN);
+  jw_number(&w, "order_line_hz", md->order_lines ? md->order_line_hz : NAN);
+  jw_number(&w, "order_line_mps2", md->order_lines ? md->order_line_mps2 : NAN);
   jw_number(&w, "mode_speed_tracking", md->speed_tracking);
   jw_number(&w, "mode_speed_tracking_se", md->speed_tracking_se);
   jw_bool(&w, "narrow_peak", md->narrow_peak);

@@ -368,6 +368,7 @@ hm_status hm_monitor_push_speed(hm_monitor m, double t, double v) {
   if (st == HM_OK) {
     m->have_speed = 1;
     m->speed_kmh = v;
+    hm_modal_set_speed(m->modal, hm_mps_from_kmh(v)); /* (kept with each sample: the lines' order tracking) */
   }
   return st;
 }

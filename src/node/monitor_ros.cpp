@@ -430,6 +430,10 @@ void MonitorRos::onTimer(const ros::TimerEvent&) {
   m.lone_line_mps2 = md.lone_lines ? finite(md.lone_line_mps2[0]) : 0.0;
   m.lone_line_wavelength_m =
       md.lone_lines && md.lone_line_hz[0] > 0.0 ? finite(hm_mps_from_kmh(st.mode_speed_kmh) / md.lone_line_hz[0]) : 0.0;
+  m.order_lines = static_cast<uint8_t>(md.order_lines);
+  m.order_line_wavelength_m = md.order_lines ? finite(md.order_line_wavelength_m) : 0.0;
+  m.order_line_hz = md.order_lines ? finite(md.order_line_hz) : 0.0;
+  m.order_line_mps2 = md.order_lines ? finite(md.order_line_mps2) : 0.0;
   m.narrow_peak = md.narrow_peak;
   m.narrow_peak_hz = md.narrow_peak ? finite(md.narrow_peak_hz) : 0.0;
   m.narrow_peak_verdict = static_cast<uint8_t>(g.narrow);
