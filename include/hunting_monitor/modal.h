@@ -79,7 +79,8 @@ typedef struct {
   double fit_interval_s;    /* a new fit after this much new data [s] */
   double tol;               /* relative change of the objective that ends the scoring */
   unsigned max_iter;        /* scoring step limit */
-  int reject_lines;         /* 1: leave the bins of a periodic track excitation (a comb of lines, lines.h) out */
+  int reject_lines;         /* 1: leave the bins of a periodic track excitation (a comb of lines, lines.h) out, and
+                               on a ramp take the track's lines out in distance first (order_lines.h) */
   double line_candidate_ratio;   /* lines.h: a candidate line is this far above its local background */
   double line_min_fundamental_hz;/* lines.h: the comb's lowest spacing [Hz] */
   unsigned line_min_harmonics;   /* lines.h: candidates on a comb needed to declare it */
@@ -136,7 +137,7 @@ typedef struct {
   double line_strongest_mps2;
   double band_excluded_fraction; /* of the band's bins left out of the fit */
   /* track lines taken out of the window's samples in distance before anything else (order_lines.h; only where the
-   * window's speed moved a line at band_high_hz by more than two bins and every sample's speed was given,
+   * window's speed trend moved a line at band_high_hz by more than two bins and every sample's speed was given,
    * hm_modal_set_speed): how many, and the strongest's wavelength [m], frequency at the window's mean speed [Hz] and
    * amplitude [m/s^2] */
   unsigned order_lines;
@@ -211,7 +212,7 @@ hm_status hm_modal_set_rate(hm_modal m, double sample_rate_hz);
 /* One acceleration sample [m/s^2] at the input rate (finite: the caller validates). */
 void hm_modal_push(hm_modal m, double accel_mps2);
 /* The speed [m/s] from now on, kept with each sample (the track lines' order tracking, order_lines.h); not finite
- * or not positive: unknown (the default, and after a reset). */
+ * or not positive: unknown (the default until one is given; a reset or a new rate keeps it). */
 void hm_modal_set_speed(hm_modal m, double v_mps);
 /* 1 when enough new data for a fit is in (fit_interval_s since the last one, min_window_s in all). */
 int hm_modal_fit_due(const hm_modal m);

@@ -19,14 +19,19 @@
  *    and it is sharper there than in time:
  *    F_d >= dominance times F_t, the F test of the time periodogram at the same frequency. A mode, fixed in time, is
  *    the other way round; at a steady speed both are the same (nothing is taken: the time-domain tests decide,
- *    modal.h). A comb's tooth that fails only that comparison is taken too when another tooth passed every test: on
- *    the mode's peak the peak's own F in time is high (16.8 m joints at 427 km/h on the independent simulator: the
- *    second harmonic at 14.1 Hz stayed, and the first window read -3.7 1/s where the mode is -5.5);
+ *    modal.h). A tooth on the mode's peak whose F in time is the peak's own may fail that comparison: it stays, and
+ *    the comb's spacing (comb_fundamental_hz) lets the caller ask the narrow-peak question there (modal.h). Taking
+ *    such teeth whenever another tooth passed (tried) took the mode with them where it is lightly damped: a tooth
+ *    amplified 30-60 times by the resonance, F 81 in distance and 10 in time, and the window read -2.4..-2.7 1/s
+ *    for -1.4 (17.5 m joints at 453 km/h, conicity 0.16; review of issue #26);
  *  - each track line is subtracted from the window's time samples at its phase in distance:
- *    x_i -= 2 Re(A exp(i omega tau_i)), tau_i the sample's virtual time.
- * Used only where the window's speed moved a line of f_hi_hz by more than two bins (f_hi spread_rel > 2 / T).
- * No allocation after create; cost per call: two real FFTs of nfft, the interpolation (n), the line search, and n
- * cosines and sines per track line.
+ *    x_i -= 2 Re(A exp(i omega tau_i)), tau_i the sample's virtual time (by a rotation, recomputed where the speed
+ *    between two samples changed: a speed held between its updates costs one sine and cosine per update).
+ * The caller decides when it is worth it (modal.c: where the window's speed trend moved a line at the band's top
+ * by more than two bins).
+ * No allocation after create; cost per call: two real FFTs of nfft, the interpolation (n), the line search, for each
+ * candidate (at most HM_ORDER_LINES_MAX) a median over +-0.5 Hz and two harmonic F fits, and n complex rotations per
+ * track line.
  */
 #ifndef HUNTING_MONITOR_ORDER_LINES_H
 #define HUNTING_MONITOR_ORDER_LINES_H
@@ -40,8 +45,10 @@
 extern "C" {
 #endif
 
-/* Track lines taken out of one window at most. */
-#define HM_ORDER_LINES_MAX 8
+/* A comb's teeth examined at most (the lowest), and track lines taken out of one window at most (those and the lone
+ * candidates, lines.h). */
+#define HM_ORDER_LINES_MAX_TEETH 16
+#define HM_ORDER_LINES_MAX (HM_ORDER_LINES_MAX_TEETH + HM_LINES_MAX_LONE)
 
 typedef struct {
   double min_ratio;  /* a lone line stands at least this times its background in distance (the median about it,
@@ -67,6 +74,8 @@ typedef struct {
   double amp_mps2[HM_ORDER_LINES_MAX];        /* amplitude [m/s^2] */
   double f_distance[HM_ORDER_LINES_MAX], f_time[HM_ORDER_LINES_MAX]; /* its F tests in distance and in time */
   double speed_mean_mps;                      /* the window's mean speed [m/s] */
+  double comb_fundamental_hz;                 /* a comb's spacing found in distance [Hz] at that speed (0: none),
+                                                 its teeth taken or not */
 } hm_order_lines_result;
 
 typedef struct hm_order_lines_s *hm_order_lines;

@@ -39,6 +39,7 @@ struct hm_modal_s {
   hm_order_lines order;        /* track lines in distance (order_lines.h) */
   double order_hz[HM_ORDER_LINES_MAX]; /* those the fit's window gave [Hz] */
   unsigned n_order;
+  double order_comb_hz;        /* and the spacing of a comb found in distance [Hz] (0: none) */
   size_t cap, n_win, head, n_in, since_fit;
   size_t min_n;                /* decimated samples in min_window_s (as many as arrive in it: rounded down) */
   double fit_every;            /* decimated samples between fits (fit_interval_s) */
@@ -153,6 +154,7 @@ hm_status hm_modal_create(const hm_modal_config *cfg, double fs, hm_modal *out, 
   m->nfft_max = pow2_at_least((double)m->cap);
   m->ring = malloc(m->cap * sizeof(double));
   m->speed = malloc(m->cap * sizeof(double));
+  m->v_now = NAN;
   m->x = malloc(m->cap * sizeof(double));
   m->xv = malloc(m->cap * sizeof(double));
   m->re = malloc(m->nfft_max * sizeof(double));
@@ -207,8 +209,7 @@ void hm_modal_reset(hm_modal m) {
   hm_biquad_clear(&m->lp[0]);
   hm_biquad_clear(&m->lp[1]);
   m->phase = 0;
-  m->head = m->n_in = m->since_fit = 0;
-  m->v_now = NAN;
+  m->head = m->n_in = m->since_fit = 0; /* (v_now is the caller's: kept) */
   for (int k = 0; k < 3; ++k) {
     m->warm[k].have1 = m->warm[k].have2 = 0;
     m->warm[k].since_split = HM_MODAL_SPLIT_EVERY - 1; /* the first fit tries the splits */
@@ -517,7 +518,8 @@ static unsigned sinusoids(const hm_modal m, const window_geometry *g, const hm_l
   return count;
 }
 
-/* A reading as narrow as a line, inside whose peak a track line was taken out in distance (take_window), in a window
+/* A reading as narrow as a line, inside whose peak a track line was taken out in distance (take_window) or a comb
+ * found there has a tooth, in a window
  * whose speed moved that line by more than a bin (f spread_rel > 1 / T): what stands is that line's residue (its
  * amplitude and phase change as it crosses the mode's resonance, which one sinusoid in distance does not follow) or
  * the mode near its Hopf speed. It is the narrow-peak question (modal.h) like a listed candidate: the line fitted at
@@ -530,8 +532,10 @@ static int swept_peak(const hm_modal m, const window_geometry *g, const hm_mode_
                       hm_lines_sinusoid *fit, double *bg) {
   if (!isfinite(rd->decay_rate_1_s) || !line_narrow(g, rd) || !(rd->frequency_hz * g->spread_rel > 1.0 / g->T))
     return 0;
-  int taken = 0;
+  int taken = 0; /* a line taken out inside the peak, or a tooth of a comb found in distance there */
   for (unsigned q = 0; q < m->n_order; ++q) taken |= in_peak(g, rd, m->order_hz[q]);
+  const double f1 = m->order_comb_hz;
+  if (f1 > 0.0) taken |= in_peak(g, rd, f1 * fmax(1.0, round(rd->frequency_hz / f1)));
   if (!taken) return 0;
   const double f = rd->frequency_hz, reach = 1.0 / g->T + rd->frequency_se_hz;
   size_t k = 0;
@@ -706,25 +710,35 @@ static int halves_tracking(hm_modal m, size_t n, const window_geometry *g, const
 }
 
 /* The last window_s (at least the n to fit) copied oldest first into m->x, with its speeds; where the newest n's
- * speed moved a line at band_high_hz by more than two bins, the track lines taken out of them in distance
- * (order_lines.h), reported in r. */
+ * speed trend moved a line at band_high_hz by more than two bins, the track lines taken out of them in distance
+ * (order_lines.h), reported in r. (Only the newest n: the halves' order tracking over window_s reads the older part
+ * as it came.) */
 static void take_window(hm_modal m, size_t n, hm_mode_estimate *r) {
   const size_t len = (size_t)fmax((double)n, fmin((double)m->n_in, floor(m->cfg.window_s * m->fd + 1e-6)));
   const size_t oldest = (m->head + m->n_win - len) % m->n_win;
-  for (size_t k = 0; k < len; ++k) m->x[k] = m->ring[(oldest + k) % m->n_win], m->xv[k] = m->speed[(oldest + k) % m->n_win];
+  for (size_t k = 0; k < len; ++k) {
+    const size_t j = (oldest + k) % m->n_win;
+    m->x[k] = m->ring[j], m->xv[k] = m->speed[j];
+  }
   m->x_len = len;
   m->n_order = 0;
+  m->order_comb_hz = 0.0;
   double *x = m->x + (len - n);
   const double *v = m->xv + (len - n);
-  double lo = INFINITY, hi = 0.0, sum = 0.0;
+  /* the speed's least-squares trend over the window (a speed signal's noise of 0.3 km/h moves its range by 2 km/h
+   * at a steady speed, and every fit would search for nothing; review of issue #26) */
+  double sum = 0.0, skv = 0.0;
   for (size_t k = 0; k < n; ++k) {
     if (!(v[k] > 0.0)) return; /* (NAN: unknown) */
-    lo = fmin(lo, v[k]), hi = fmax(hi, v[k]), sum += v[k];
+    sum += v[k], skv += ((double)k - 0.5 * (double)(n - 1)) * v[k];
   }
-  const double T = (double)n / m->fd;
-  if (!(m->cfg.reject_lines && m->cfg.band_high_hz * (hi - lo) / (sum / (double)n) > 2.0 / T)) return;
+  const double nn = (double)n, slope = skv / (nn * (nn * nn - 1.0) / 12.0); /* per sample */
+  const double T = nn / m->fd, trend_rel = fabs(slope) * (nn - 1.0) / (sum / nn);
+  if (!(m->cfg.reject_lines && m->cfg.band_high_hz * trend_rel > 2.0 / T)) return;
   hm_order_lines_result o;
-  if (hm_order_lines_clean(m->order, x, v, n, m->fd, m->nfft, 2.5, 0.3 * m->fd, &o) != HM_OK || o.n == 0) return;
+  if (hm_order_lines_clean(m->order, x, v, n, m->fd, m->nfft, 2.5, 0.3 * m->fd, &o) != HM_OK) return;
+  m->order_comb_hz = o.comb_fundamental_hz;
+  if (o.n == 0) return;
   unsigned best = 0;
   for (unsigned q = 1; q < o.n; ++q)
     if (o.amp_mps2[q] > o.amp_mps2[best]) best = q;

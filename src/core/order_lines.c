@@ -65,7 +65,11 @@ hm_status hm_order_lines_create(const hm_order_lines_config *cfg, const hm_lines
   if (!cfg || !lines_cfg || !out) return HM_EINVAL;
   hm_status st = hm_order_lines_config_validate(cfg, why, len);
   if (st != HM_OK) return st;
-  if (max_n < 8 || nfft_max < max_n || (nfft_max & (nfft_max - 1)) != 0) {
+  if (max_n < 8) {
+    if (why && len) snprintf(why, len, "max_n: must be at least 8 (got %zu)", max_n);
+    return HM_EDOMAIN;
+  }
+  if (nfft_max < max_n || (nfft_max & (nfft_max - 1)) != 0) {
     if (why && len) snprintf(why, len, "nfft_max: must be a power of two >= max_n (got %zu for %zu)", nfft_max, max_n);
     return HM_EDOMAIN;
   }
@@ -104,7 +108,8 @@ hm_status hm_order_lines_create(const hm_order_lines_config *cfg, const hm_lines
 
 /* Catmull-Rom through x[i-1..i+2] at u in [0, 1) past x[i] (the ends repeated). */
 static double cubic(const double *x, size_t n, size_t i, double u) {
-  const double p0 = x[i > 0 ? i - 1 : 0], p1 = x[i], p2 = x[i + 1 < n ? i + 1 : n - 1], p3 = x[i + 2 < n ? i + 2 : n - 1];
+  const double p0 = x[i > 0 ? i - 1 : 0], p1 = x[i];
+  const double p2 = x[i + 1 < n ? i + 1 : n - 1], p3 = x[i + 2 < n ? i + 2 : n - 1];
   return 0.5 * (2.0 * p1 + (p2 - p0) * u + (2.0 * p0 - 5.0 * p1 + 4.0 * p2 - p3) * u * u +
                 (3.0 * (p1 - p2) + p3 - p0) * u * u * u);
 }
@@ -152,6 +157,7 @@ hm_status hm_order_lines_clean(hm_order_lines o, double *x, const double *v, siz
   for (size_t i = 1; i < n; ++i) o->s[i] = o->s[i - 1] + 0.5 * (v[i - 1] + v[i]) / fs;
   const double total = o->s[n - 1], step = total / (double)(n - 1);
   r.speed_mean_mps = total * fs / (double)(n - 1);
+  r.comb_fundamental_hz = 0.0;
   size_t i = 0;
   for (size_t j = 0; j < n; ++j) {
     const double sj = (double)j * step;
@@ -170,62 +176,57 @@ hm_status hm_order_lines_clean(hm_order_lines o, double *x, const double *v, siz
     return HM_OK;
   }
   /* the candidates: a comb's teeth, then the lone ones */
-  double cand[HM_ORDER_LINES_MAX + HM_LINES_MAX_LONE];
+  double cand[HM_ORDER_LINES_MAX];
   unsigned nc = 0;
   if (lr.found && lr.fundamental_hz > 0.0)
-    for (double f = ceil(f_lo / lr.fundamental_hz) * lr.fundamental_hz; f <= f_hi && nc < HM_ORDER_LINES_MAX;
+    for (double f = ceil(f_lo / lr.fundamental_hz) * lr.fundamental_hz; f <= f_hi && nc < HM_ORDER_LINES_MAX_TEETH;
          f += lr.fundamental_hz)
       cand[nc++] = f;
-  const unsigned n_teeth = nc; /* (a comb is evidence of its own: its teeth need no more than to be candidates) */
+  const unsigned n_teeth = nc; /* (a comb is evidence of its own: no min_ratio for its teeth) */
+  if (n_teeth > 0) r.comb_fundamental_hz = lr.fundamental_hz;
   for (unsigned k = 0; k < lr.n_lone; ++k) cand[nc++] = lr.lone_hz[k];
   const size_t m = (size_t)ceil(3.0 * (double)nfft / (double)n) + 1;
   double spread = 0.0, vmin = v[0], vmax = v[0];
   for (size_t k = 1; k < n; ++k) vmin = fmin(vmin, v[k]), vmax = fmax(vmax, v[k]);
   spread = (vmax - vmin) / r.speed_mean_mps;
   hm_lines_sinusoid fits[HM_ORDER_LINES_MAX];
-  /* two passes: every candidate on its own tests; then a comb's teeth that failed only the comparison with time
-   * (a tooth on the mode's peak, where the peak's own F in time is high) when another tooth passed everything */
-  unsigned char taken[HM_ORDER_LINES_MAX + HM_LINES_MAX_LONE] = {0}, only_time[HM_ORDER_LINES_MAX + HM_LINES_MAX_LONE] = {0};
-  hm_lines_sinusoid fdist[HM_ORDER_LINES_MAX + HM_LINES_MAX_LONE];
-  double ftime[HM_ORDER_LINES_MAX + HM_LINES_MAX_LONE];
-  int tooth_passed = 0;
-  for (unsigned c = 0; c < nc; ++c) {
+  for (unsigned c = 0; c < nc && r.n < HM_ORDER_LINES_MAX; ++c) {
     const size_t kd = strongest(o->dpow, nb, df, cand[c], 1.0 / T, m);
-    hm_lines_sinusoid ft;
+    hm_lines_sinusoid fd, ft;
     if (kd == 0 || (c >= n_teeth && !(ratio_at(o, o->dpow, nb, df, kd) >= o->cfg.min_ratio)) ||
-        hm_lines_fit_sinusoid(o->dre, o->dim, nb, kd, n, nfft, &fdist[c]) != HM_OK || !(fdist[c].f_stat >= o->cfg.min_f))
+        hm_lines_fit_sinusoid(o->dre, o->dim, nb, kd, n, nfft, &fd) != HM_OK || !(fd.f_stat >= o->cfg.min_f))
       continue;
-    const double f = fdist[c].omega * fs / (2.0 * HM_PI);
+    const double f = fd.omega * fs / (2.0 * HM_PI);
     /* in time: the most line-like peak over the band the line swept */
     const size_t kt = strongest(o->tpow, nb, df, f, 0.5 * f * spread + 1.0 / T, m);
-    ftime[c] = kt != 0 && hm_lines_fit_sinusoid(o->tre, o->tim, nb, kt, n, nfft, &ft) == HM_OK ? ft.f_stat : 0.0;
-    if (fdist[c].f_stat >= o->cfg.dominance * ftime[c]) {
-      taken[c] = 1;
-      tooth_passed |= c < n_teeth;
-    } else {
-      only_time[c] = c < n_teeth;
-    }
-  }
-  for (unsigned c = 0; c < nc && r.n < HM_ORDER_LINES_MAX; ++c) {
-    if (!taken[c] && !(only_time[c] && tooth_passed)) continue;
-    const double f = fdist[c].omega * fs / (2.0 * HM_PI);
+    const double ft_stat =
+        kt != 0 && hm_lines_fit_sinusoid(o->tre, o->tim, nb, kt, n, nfft, &ft) == HM_OK ? ft.f_stat : 0.0;
+    if (!(fd.f_stat >= o->cfg.dominance * ft_stat)) continue;
     int dup = 0; /* a tooth also listed as a lone candidate */
     for (unsigned q = 0; q < r.n; ++q) dup |= fabs(r.f_hz[q] - f) < 1.0 / T;
     if (dup) continue;
-    fits[r.n] = fdist[c];
+    fits[r.n] = fd;
     r.f_hz[r.n] = f;
     r.wavelength_m[r.n] = r.speed_mean_mps / f;
-    r.amp_mps2[r.n] = 2.0 * hypot(fdist[c].amp_re, fdist[c].amp_im);
-    r.f_distance[r.n] = fdist[c].f_stat;
-    r.f_time[r.n] = ftime[c];
+    r.amp_mps2[r.n] = 2.0 * hypot(fd.amp_re, fd.amp_im);
+    r.f_distance[r.n] = fd.f_stat;
+    r.f_time[r.n] = ft_stat;
     ++r.n;
   }
-  /* each line out of the time samples at its phase in distance (virtual time tau_i = s_i / step samples) */
-  for (unsigned q = 0; q < r.n; ++q)
+  /* each line out of the time samples at its phase in distance (virtual time tau_i = s_i / step samples), by a
+   * rotation recomputed where the distance between samples changed */
+  for (unsigned q = 0; q < r.n; ++q) {
+    double c = 1.0, sn = 0.0, rc = 1.0, rs = 0.0, ds_last = NAN; /* (s[0] = 0: phase 0) */
     for (size_t k = 0; k < n; ++k) {
-      const double ph = fits[q].omega * o->s[k] / step;
-      x[k] -= 2.0 * (fits[q].amp_re * cos(ph) - fits[q].amp_im * sin(ph));
+      if (k > 0) {
+        const double ds = o->s[k] - o->s[k - 1];
+        if (ds != ds_last) rc = cos(fits[q].omega * ds / step), rs = sin(fits[q].omega * ds / step), ds_last = ds;
+        const double c1 = c * rc - sn * rs;
+        sn = sn * rc + c * rs, c = c1;
+      }
+      x[k] -= 2.0 * (fits[q].amp_re * c - fits[q].amp_im * sn);
     }
+  }
   *out = r;
   return HM_OK;
 }

@@ -540,6 +540,67 @@ static void coverage_of_the_intervals(void) {
   HM_CHECK(cov_leak >= 0.9 * n_all, "coverage %d/%d below 90%%", cov_leak, n_all);
 }
 
+/* The intervals on processes the fit does not assume (issue #26: coverage measured on misspecified processes, not
+ * only on the single pole): 24 windows of 40 s at 1 kHz each of (a) the mode (-2 1/s, 14.0 Hz) with a line beside
+ * it (15.2 Hz, 0.5 of the mode's r.m.s.: a slab's fundamental); (b) the mode at -0.56 1/s, 14.24 Hz, with a broad
+ * pair (-8 1/s) at the same frequency at 3.5% of its peak, and (c) at 14% (the issue's 505 and 549 km/h for a truth
+ * of 473.8); (d) two close modes, -1.0 1/s at 14.0 Hz and -3.0 1/s at 14.6 Hz, equally driven (the least damped is
+ * the truth). Covered: |sigma - truth| within two of the margin's errors (margin.h: the statistical one in quadrature
+ * with 5% + 1 / T and the difference to a two-pair reading the likelihood could not rule out). (a) and (b) at least
+ * 20 of 24 each (a true 95% gives fewer with probability 0.7%): 23 and 23. (c) and (d) are measured and printed, not
+ * bounded: 18 and 17 of 24 (75%, 71%), every miss on the damped side (one pair chosen, reading -1.4..-2.3 1/s for
+ * -0.56, or the two close modes averaged to -1.0..-2.3 for -1.0): a known limit (docs/TESTS.md). */
+static void coverage_on_misspecified_processes(void) {
+  const double fs = 1000.0, T = 40.0;
+  const char *names[4] = {"a line beside the mode", "a broad mode at 3.5%", "a broad mode at 14%", "two close modes"};
+  const double truth[4] = {-2.0, -0.56, -0.56, -1.0};
+  int all_n = 0, all_in = 0;
+  for (int p = 0; p < 4; ++p) {
+    hm_modal_config c;
+    hm_modal_config_default(&c);
+    hm_modal m = NULL;
+    HM_CHECK(hm_modal_create(&c, fs, &m, NULL, 0) == HM_OK, "create");
+    if (!m) return;
+    hm_test_rng_state = 0x5DEECE66Dull + (unsigned long long)p;
+    pole_pair p1, p2;
+    double a_line = 0.0;
+    if (p == 0) {
+      p1 = pole_pair_make(-2.0, 14.0, fs, 1.0);
+      p2 = pole_pair_make(-2.0, 14.0, fs, 0.0);
+    } else if (p <= 2) {
+      p1 = pole_pair_make(-0.56, 14.24, fs, 1.0);
+      p2 = pole_pair_make(-8.0, 14.24, fs, sqrt(p == 1 ? 0.035 : 0.14) * 8.0 / 0.56);
+    } else {
+      p1 = pole_pair_make(-1.0, 14.0, fs, 1.0);
+      p2 = pole_pair_make(-3.0, 14.6, fs, 1.0);
+    }
+    double ms = 0.0;
+    for (int k = 0; k < 200000; ++k) {
+      const double x = pole_pair_step(&p1) + pole_pair_step(&p2);
+      if (k >= 100000) ms += x * x / 100000.0;
+    }
+    if (p == 0) a_line = 0.5 * sqrt(2.0 * ms);
+    double t = 0.0;
+    int n = 0, in = 0;
+    for (int win = 0; win < 24; ++win) {
+      hm_mode_estimate e;
+      if (fit_window(m, fs, T, &p1, &p2, a_line, 15.2, 0.1 * sqrt(ms), &t, &e) != HM_OK || !e.valid) continue;
+      ++n;
+      /* the margin's error of the decay rate (margin.h): statistical, in quadrature with the systematic 5% + 1 / T
+       * and the difference to a two-pair reading the likelihood could not rule out */
+      double sys = 0.05 * fabs(e.decay_rate_1_s) + 1.0 / T;
+      if (e.decay_rate_alt_1_s < 0.0) sys = hypot(sys, e.decay_rate_1_s - e.decay_rate_alt_1_s);
+      in += fabs(e.decay_rate_1_s - truth[p]) <= 2.0 * hypot(e.decay_rate_se_1_s, sys);
+    }
+    hm_modal_destroy(m);
+    printf("  %s: %d valid of 24, the interval covers %d (%.0f%%)\n", names[p], n, in, n ? 100.0 * in / n : 0.0);
+    HM_CHECK(n >= 20, "%s: %d valid", names[p], n);
+    if (p <= 1) HM_CHECK(in >= 20, "%s: %d covered", names[p], in); /* (c) and (d): measured, a known limit */
+    all_n += n, all_in += in;
+  }
+  printf("  misspecified processes: %d of %d covered (%.1f%%)\n", all_in, all_n, 100.0 * all_in / all_n);
+}
+
 static void bad_configuration(void) {
   hm_modal_config c;
   char why[128];
@@ -608,6 +669,7 @@ int main(void) {
   HM_RUN(rates_and_no_mode);
   HM_RUN(joints_are_not_the_mode);
   HM_RUN(coverage_of_the_intervals);
+  HM_RUN(coverage_on_misspecified_processes);
   HM_RUN(bad_configuration);
   HM_TEST_EXIT();
 }

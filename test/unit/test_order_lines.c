@@ -110,6 +110,28 @@ static void joints_comb(void) {
   hm_order_lines_destroy(o);
 }
 
+/* A long comb and a lone line together (review of issue #26: with the teeth listed first and a cap of 8, a 6.45 m
+ * slab line beside 60 m joints was never examined): 60 m joints (a comb of 14 teeth in 2.5-30 Hz at 120 m/s) and
+ * a 6.45 m line of 0.4 m/s^2 over a ramp of 120-126 m/s: the line taken out at 6.45 m, the comb's spacing V / 60. */
+static void comb_and_lone_line(void) {
+  hm_order_lines o = make();
+  static double x[N], v[N];
+  const double L = 60.0, Ls = 6.45, v0 = 120.0, acc = 6.0 / (N / FS);
+  unsigned long long st = 5;
+  for (int i = 0; i < N; ++i) {
+    const double t = i / FS, s = v0 * t + 0.5 * acc * t * t, p = fmod(s, L);
+    v[i] = v0 + acc * t;
+    x[i] = (p < 1.0 ? 0.8 * (1.0 - cos(2.0 * HM_PI * p)) : 0.0) + 0.4 * cos(2.0 * HM_PI * s / Ls) + gauss(&st, 0.05);
+  }
+  hm_order_lines_result r;
+  HM_CHECK(hm_order_lines_clean(o, x, v, N, FS, NFFT, 2.5, 30.0, &r) == HM_OK, "clean");
+  int slab = 0;
+  for (unsigned q = 0; q < r.n; ++q) slab |= fabs(r.wavelength_m[q] - Ls) < 0.005 * Ls;
+  HM_CHECK(slab, "the 6.45 m line among the %u taken", r.n);
+  HM_CHECK_REL(r.comb_fundamental_hz, r.speed_mean_mps / L, 0.01, "the comb's spacing");
+  hm_order_lines_destroy(o);
+}
+
 static void bad_input(void) {
   hm_order_lines_config c;
   hm_order_lines_config_default(&c);
@@ -150,6 +172,7 @@ int main(void) {
   HM_RUN(ramp_line_taken_out);
   HM_RUN(steady_takes_nothing);
   HM_RUN(joints_comb);
+  HM_RUN(comb_and_lone_line);
   HM_RUN(bad_input);
   HM_TEST_EXIT();
 }
