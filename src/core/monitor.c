@@ -179,6 +179,7 @@ static void restart_input(hm_monitor m) {
   m->modal_ok = hm_modal_set_rate(m->modal, m->cfg.estimator.sample_rate_hz) == HM_OK;
   m->restarts = hm_estimator_restarts(m->est, &m->rate_hz);
   m->have_speed = 0;
+  hm_modal_set_speed(m->modal, NAN); /* (the identification keeps a speed across its own resets: not the old stream's) */
   memset(&m->mode, 0, sizeof m->mode);
   m->mode.speed_tracking = m->mode.speed_tracking_se = NAN; /* not measured */
   m->verdict = HM_WINDOW_MODE_INVALID;
