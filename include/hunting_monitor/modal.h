@@ -194,6 +194,9 @@ typedef struct {
 
 /* The reading as the window's estimate (its fields copied; the window's lines kept), and the estimate's own reading. */
 void hm_mode_estimate_use_reading(hm_mode_estimate *e, const hm_mode_reading *r);
+/* The reading beside a narrow peak taken for a line: line_reading_wide for a peak known for a track line
+ * (narrow_peak_tracked), else line_reading. */
+const hm_mode_reading *hm_mode_estimate_beside_line(const hm_mode_estimate *e);
 void hm_mode_estimate_reading(const hm_mode_estimate *e, hm_mode_reading *r);
 
 typedef struct hm_modal_s *hm_modal;

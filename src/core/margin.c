@@ -307,8 +307,8 @@ static hm_window_verdict prepare(const hm_margin m, double t_end, double speed_k
   const int tracked = mode->narrow_peak_tracked; /* a track line by its wavelength across speeds: never the mode */
   if (!tracked && v == HM_WINDOW_USED && supports_narrow(m, w)) return *narrow = HM_NARROW_MODE, v;
   window wl;
-  const hm_window_verdict vl = prepare_reading(m, t_end, speed_kmh, spread_kmh, mode->window_s,
-                                               tracked ? &mode->line_reading_wide : &mode->line_reading, &wl);
+  const hm_window_verdict vl =
+      prepare_reading(m, t_end, speed_kmh, spread_kmh, mode->window_s, hm_mode_estimate_beside_line(mode), &wl);
   const int impossible = v == HM_WINDOW_MISFIT || v == HM_WINDOW_NO_INVERSION;
   const int beside = primary.poles == 2 || fabs(mode->line_reading.frequency_hz - primary.frequency_hz) > 1.0;
   /* the mode beside it, where what is known supports it, or where it is the cautious reading (wheels worn beyond the

@@ -170,9 +170,10 @@ hm_status hm_modal_create(const hm_modal_config *cfg, double fs, hm_modal *out, 
   const hm_lines_config lc = lines_config(cfg);
   hm_order_lines_config oc;
   hm_order_lines_config_default(&oc);
-  if (!m->ring || !m->speed || !m->x || !m->xv ||
-      hm_order_lines_create(&oc, &lc, m->cap, m->nfft_max, &m->order, NULL, 0) != HM_OK || !m->re || !m->im || !m->cosw || !m->sinw || !m->w || !m->pgram || !m->u || !m->power ||
-      !m->excluded || !m->set_aside || hm_lines_create(&lc, m->nfft_max / 2 + 1, &m->lines, NULL, 0) != HM_OK) {
+  if (!m->ring || !m->speed || !m->x || !m->xv || !m->re || !m->im || !m->cosw || !m->sinw || !m->w || !m->pgram ||
+      !m->u || !m->power || !m->excluded || !m->set_aside ||
+      hm_lines_create(&lc, m->nfft_max / 2 + 1, &m->lines, NULL, 0) != HM_OK ||
+      hm_order_lines_create(&oc, &lc, m->cap, m->nfft_max, &m->order, NULL, 0) != HM_OK) {
     hm_modal_destroy(m);
     return HM_ENOMEM;
   }
@@ -246,6 +247,10 @@ int hm_modal_fit_due(const hm_modal m) {
   return m && m->n_in >= m->min_n && (double)m->since_fit >= m->fit_every;
 }
 
+
+const hm_mode_reading *hm_mode_estimate_beside_line(const hm_mode_estimate *e) {
+  return e->narrow_peak_tracked ? &e->line_reading_wide : &e->line_reading;
+}
 
 void hm_mode_estimate_use_reading(hm_mode_estimate *e, const hm_mode_reading *r) {
   if (!e || !r) return;

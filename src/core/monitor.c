@@ -323,8 +323,7 @@ static void fit(hm_monitor m, double t) {
   if (m->verdict == HM_WINDOW_CHANGE) m->committed_until = t; /* the change's window is committed (margin.h) */
   /* a narrow peak the margin took for a line: the mode shown is the one beside it */
   if (m->mode.narrow_peak && hm_margin_last_narrow(m->margin) == HM_NARROW_LINE) {
-    hm_mode_estimate_use_reading(&m->mode, m->mode.narrow_peak_tracked ? &m->mode.line_reading_wide
-                                                                       : &m->mode.line_reading);
+    hm_mode_estimate_use_reading(&m->mode, hm_mode_estimate_beside_line(&m->mode));
     m->mode.speed_tracking = m->mode.speed_tracking_se = NAN; /* measured on the narrow peak's reading, not this one */
   }
 }

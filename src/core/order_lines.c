@@ -135,6 +135,9 @@ static size_t strongest(const double *pw, size_t nb, double df, double f, double
   return best;
 }
 
+/* The distance [m] from sample i - 1 to sample i at fs (the trapezoid of their speeds). */
+static double step_m(const double *v, size_t i, double fs) { return 0.5 * (v[i - 1] + v[i]) / fs; }
+
 /* pw[k] over its local background: the median of pw within +-half_hz (bins of df) over ln 2 (lines.h). */
 static double ratio_at(const hm_order_lines o, const double *pw, size_t nb, double df, size_t k) {
   const size_t h = (size_t)ceil(o->halfwidth_hz / df), a = k > h ? k - h : 0, b = k + h + 1 < nb ? k + h + 1 : nb;
@@ -152,12 +155,17 @@ hm_status hm_order_lines_clean(hm_order_lines o, double *x, const double *v, siz
     if (!(isfinite(v[i]) && v[i] > 0.0)) return HM_EDOMAIN;
   hm_order_lines_result r;
   memset(&r, 0, sizeof r);
-  /* each sample's distance, and the window resampled equally in distance (its virtual time: distance / mean speed) */
+  /* each sample's distance (and the speed's range), and the window resampled equally in distance (its virtual
+   * time: distance / mean speed) */
+  double vmin = v[0], vmax = v[0];
   o->s[0] = 0.0;
-  for (size_t i = 1; i < n; ++i) o->s[i] = o->s[i - 1] + 0.5 * (v[i - 1] + v[i]) / fs;
+  for (size_t i = 1; i < n; ++i) {
+    o->s[i] = o->s[i - 1] + step_m(v, i, fs);
+    vmin = fmin(vmin, v[i]), vmax = fmax(vmax, v[i]);
+  }
   const double total = o->s[n - 1], step = total / (double)(n - 1);
   r.speed_mean_mps = total * fs / (double)(n - 1);
-  r.comb_fundamental_hz = 0.0;
+  const double spread = (vmax - vmin) / r.speed_mean_mps;
   size_t i = 0;
   for (size_t j = 0; j < n; ++j) {
     const double sj = (double)j * step;
@@ -186,9 +194,6 @@ hm_status hm_order_lines_clean(hm_order_lines o, double *x, const double *v, siz
   if (n_teeth > 0) r.comb_fundamental_hz = lr.fundamental_hz;
   for (unsigned k = 0; k < lr.n_lone; ++k) cand[nc++] = lr.lone_hz[k];
   const size_t m = (size_t)ceil(3.0 * (double)nfft / (double)n) + 1;
-  double spread = 0.0, vmin = v[0], vmax = v[0];
-  for (size_t k = 1; k < n; ++k) vmin = fmin(vmin, v[k]), vmax = fmax(vmax, v[k]);
-  spread = (vmax - vmin) / r.speed_mean_mps;
   hm_lines_sinusoid fits[HM_ORDER_LINES_MAX];
   for (unsigned c = 0; c < nc && r.n < HM_ORDER_LINES_MAX; ++c) {
     const size_t kd = strongest(o->dpow, nb, df, cand[c], 1.0 / T, m);
@@ -214,12 +219,13 @@ hm_status hm_order_lines_clean(hm_order_lines o, double *x, const double *v, siz
     ++r.n;
   }
   /* each line out of the time samples at its phase in distance (virtual time tau_i = s_i / step samples), by a
-   * rotation recomputed where the distance between samples changed */
+   * rotation recomputed where the distance between samples changed (from the speeds: their difference of s would
+   * differ by rounding and recompute it at a tenth of the samples of a held speed) */
   for (unsigned q = 0; q < r.n; ++q) {
     double c = 1.0, sn = 0.0, rc = 1.0, rs = 0.0, ds_last = NAN; /* (s[0] = 0: phase 0) */
     for (size_t k = 0; k < n; ++k) {
       if (k > 0) {
-        const double ds = o->s[k] - o->s[k - 1];
+        const double ds = step_m(v, k, fs);
         if (ds != ds_last) rc = cos(fits[q].omega * ds / step), rs = sin(fits[q].omega * ds / step), ds_last = ds;
         const double c1 = c * rc - sn * rs;
         sn = sn * rc + c * rs, c = c1;
