@@ -141,6 +141,10 @@ hm_status hm_model_rhs(double t, const double *x, double *dxdt, void *model);
 /* Analytic Jacobian df/dx, row-major 4x4 (jac[4*i + j] = d f_i / d x_j); signature of an hm_ode_jac_fn. */
 hm_status hm_model_jacobian(double t, const double *x, double *jac, void *model);
 
+/* The same two at speed_mps instead of mdl->speed_mps (system.h's wheelset: one model, any speed). */
+hm_status hm_model_rhs_at(const hm_model *mdl, double speed_mps, const double *x, double *dxdt);
+hm_status hm_model_jacobian_at(const hm_model *mdl, double speed_mps, const double *x, double *jac);
+
 #ifdef __cplusplus
 }
 #endif

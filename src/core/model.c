@@ -5,6 +5,8 @@
 #include <stdio.h>
 #include <string.h>
 
+#include "validate.h"
+
 void hm_vehicle_default(hm_vehicle *veh) {
   memset(veh, 0, sizeof *veh);
   veh->mass_kg = 1869.0;
@@ -26,43 +28,28 @@ void hm_vehicle_default(hm_vehicle *veh) {
   veh->flange_alpha2_n_m5 = 1.6e15;
 }
 
-/* Write "field: reason (got value)" and return HM_EDOMAIN. */
-static hm_status reject(char *why, size_t why_len, const char *field, const char *reason, double got) {
-  if (why && why_len > 0) snprintf(why, why_len, "%s: %s (got %g)", field, reason, got);
-  return HM_EDOMAIN;
-}
-
-typedef struct {
-  const char *field;
-  double value;
-  int allow_zero;
-} positive_field;
-
 hm_status hm_vehicle_validate(const hm_vehicle *veh, char *why, size_t why_len) {
   if (!veh) {
     if (why && why_len > 0) snprintf(why, why_len, "vehicle: NULL pointer");
     return HM_EINVAL;
   }
-  const positive_field pos[] = {
-      {"vehicle.mass_kg", veh->mass_kg, 0},
-      {"vehicle.yaw_inertia_kg_m2", veh->yaw_inertia_kg_m2, 0},
-      {"vehicle.contact_half_distance_m", veh->contact_half_distance_m, 0},
-      {"vehicle.spring_half_distance_m", veh->spring_half_distance_m, 0},
-      {"vehicle.rolling_radius_m", veh->rolling_radius_m, 0},
-      {"vehicle.creep_long_n", veh->creep_long_n, 0},
-      {"vehicle.creep_lat_n", veh->creep_lat_n, 0},
-      {"vehicle.spring_ratio", veh->spring_ratio, 0},
-      {"vehicle.kx_mn_m", veh->stiffness_long_n_m / 1e6, 0},
-      {"vehicle.ky_mn_m", veh->stiffness_lat_n_m / 1e6, 1},
-      {"conicity.constant", veh->conicity.constant, 1},
+  const hm_field_check checks[] = {
+      {"vehicle.mass_kg", veh->mass_kg, HM_RULE_POSITIVE},
+      {"vehicle.yaw_inertia_kg_m2", veh->yaw_inertia_kg_m2, HM_RULE_POSITIVE},
+      {"vehicle.contact_half_distance_m", veh->contact_half_distance_m, HM_RULE_POSITIVE},
+      {"vehicle.spring_half_distance_m", veh->spring_half_distance_m, HM_RULE_POSITIVE},
+      {"vehicle.rolling_radius_m", veh->rolling_radius_m, HM_RULE_POSITIVE},
+      {"vehicle.creep_long_n", veh->creep_long_n, HM_RULE_POSITIVE},
+      {"vehicle.creep_lat_n", veh->creep_lat_n, HM_RULE_POSITIVE},
+      {"vehicle.spring_ratio", veh->spring_ratio, HM_RULE_POSITIVE},
+      {"vehicle.kx_mn_m", veh->stiffness_long_n_m / 1e6, HM_RULE_POSITIVE},
+      {"vehicle.ky_mn_m", veh->stiffness_lat_n_m / 1e6, HM_RULE_NONNEG},
+      {"conicity.constant", veh->conicity.constant, HM_RULE_NONNEG},
   };
-  for (size_t i = 0; i < sizeof pos / sizeof pos[0]; ++i) {
-    if (!isfinite(pos[i].value)) return reject(why, why_len, pos[i].field, "must be a finite number", pos[i].value);
-    if (pos[i].allow_zero ? pos[i].value < 0.0 : pos[i].value <= 0.0)
-      return reject(why, why_len, pos[i].field, pos[i].allow_zero ? "must be >= 0" : "must be > 0", pos[i].value);
-  }
+  hm_status st = hm_check_fields(checks, sizeof checks / sizeof checks[0], why, why_len);
+  if (st != HM_OK) return st;
   if (veh->conicity.n_terms > HM_CONICITY_MAX_TERMS)
-    return reject(why, why_len, "conicity.gaussians", "too many terms (at most 8)", (double)veh->conicity.n_terms);
+    return hm_reject(why, why_len, "conicity.gaussians", "too many terms (at most 8)", (double)veh->conicity.n_terms);
   for (size_t i = 0; i < veh->conicity.n_terms; ++i) {
     const hm_gaussian *g = &veh->conicity.terms[i];
     const char *part = NULL, *reason = "must be a finite number";
@@ -81,13 +68,13 @@ hm_status hm_vehicle_validate(const hm_vehicle *veh, char *why, size_t why_len) 
     if (part) {
       char field[64];
       snprintf(field, sizeof field, "conicity.gaussians[%zu].%s", i, part);
-      return reject(why, why_len, field, reason, got);
+      return hm_reject(why, why_len, field, reason, got);
     }
   }
   if (!isfinite(veh->flange_alpha1_n_m3))
-    return reject(why, why_len, "flange.alpha1_n_m3", "must be a finite number", veh->flange_alpha1_n_m3);
+    return hm_reject(why, why_len, "flange.alpha1_n_m3", "must be a finite number", veh->flange_alpha1_n_m3);
   if (!isfinite(veh->flange_alpha2_n_m5))
-    return reject(why, why_len, "flange.alpha2_n_m5", "must be a finite number", veh->flange_alpha2_n_m5);
+    return hm_reject(why, why_len, "flange.alpha2_n_m5", "must be a finite number", veh->flange_alpha2_n_m5);
   return HM_OK;
 }
 
@@ -255,8 +242,12 @@ hm_status hm_model_init(hm_model *mdl, const hm_vehicle *veh, double speed_mps) 
 hm_status hm_model_rhs(double t, const double *x, double *dxdt, void *model) {
   (void)t;
   const hm_model *mdl = (const hm_model *)model;
+  return hm_model_rhs_at(mdl, mdl->speed_mps, x, dxdt);
+}
+
+hm_status hm_model_rhs_at(const hm_model *mdl, double speed_mps, const double *x, double *dxdt) {
   const hm_linear_coef *c = &mdl->coef;
-  const double inv_v = 1.0 / mdl->speed_mps;
+  const double inv_v = 1.0 / speed_mps;
   const double y = x[0], y2 = y * y;
   double lambda;
   hm_conicity_eval(&mdl->vehicle.conicity, y, &lambda, NULL);
@@ -276,8 +267,12 @@ hm_status hm_model_rhs(double t, const double *x, double *dxdt, void *model) {
 hm_status hm_model_jacobian(double t, const double *x, double *jac, void *model) {
   (void)t;
   const hm_model *mdl = (const hm_model *)model;
+  return hm_model_jacobian_at(mdl, mdl->speed_mps, x, jac);
+}
+
+hm_status hm_model_jacobian_at(const hm_model *mdl, double speed_mps, const double *x, double *jac) {
   const hm_linear_coef *c = &mdl->coef;
-  const double inv_v = 1.0 / mdl->speed_mps;
+  const double inv_v = 1.0 / speed_mps;
   const double y = x[0], y2 = y * y;
   double lambda, dlambda;
   hm_conicity_eval(&mdl->vehicle.conicity, y, &lambda, &dlambda);

@@ -1,0 +1,92 @@
+/*
+ * hunting_monitor - a vehicle model of any state dimension, and its linear stability at the origin (issue #28).
+ *
+ * A model is its state dimension, its right-hand side f(x; v) and Jacobian df/dx at a running speed v, and what its
+ * states are: the body each belongs to (a category: "wheelsets", "bogie frame", "carbody") and the mass or inertia of
+ * each velocity state, so that a mode can be said to move the wheelsets, the frame or the carbody (its kinetic
+ * energy's shares). The wheelset of docs/MODEL.md (hm_wheelset_system_init below) and the two-axle bogie (bogie.h)
+ * give one.
+ *
+ * Linear stability: the Jacobian's eigenvalues at x = 0 (LAPACK dgeev), sorted by decreasing real part; the least
+ * damped one and its mode's body shares; the linear critical (Hopf) speed: a scan upward from v_min in steps of
+ * v_step for the first speed where the largest real part is >= 0, then bisection to tol. Nothing is allocated
+ * (dimension at most HM_SYSTEM_MAX_DIM; the work arrays are on the stack, about 50 kB).
+ */
+#ifndef HUNTING_MONITOR_SYSTEM_H
+#define HUNTING_MONITOR_SYSTEM_H
+
+#include <stddef.h>
+
+#include "hunting_monitor/model.h"
+#include "hunting_monitor/status.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+#define HM_SYSTEM_MAX_DIM 40
+#define HM_SYSTEM_MAX_BODIES 4
+
+/* f(x; v) and df/dx (row-major, dim x dim: jac[dim * i + j] = d f_i / d x_j) of the model's parameters at speed v
+ * [m/s]. HM_ENONFINITE if a value is not finite. */
+typedef hm_status (*hm_system_rhs_fn)(const void *model, double speed_mps, const double *x, double *dxdt);
+typedef hm_status (*hm_system_jac_fn)(const void *model, double speed_mps, const double *x, double *jac);
+
+typedef struct {
+  size_t dim;                    /* state dimension, 1..HM_SYSTEM_MAX_DIM */
+  hm_system_rhs_fn rhs;
+  hm_system_jac_fn jacobian;
+  const void *model;             /* what rhs and jacobian read (kept by the caller while the system is used) */
+  size_t n_bodies;               /* 1..HM_SYSTEM_MAX_BODIES */
+  const char *const *body_names; /* n_bodies names */
+  const int *state_body;         /* per state: its body (0..n_bodies-1), or -1 (a damper's internal state) */
+  const double *state_inertia;   /* per state: the mass [kg] or inertia [kg m^2] of a velocity state, else 0 */
+} hm_system;
+
+/* The spectrum at one speed. */
+typedef struct {
+  size_t dim;
+  double re[HM_SYSTEM_MAX_DIM], im[HM_SYSTEM_MAX_DIM]; /* eigenvalues [1/s]: decreasing real part, of a pair the
+                                                          one with im > 0 first */
+  double abscissa_1_s;           /* re[0]: the least-damped eigenvalue's real part (the decay rate) */
+  double frequency_hz;           /* im[0] / 2 pi (0: a real eigenvalue) */
+  double body_share[HM_SYSTEM_MAX_BODIES]; /* its mode's kinetic energy by body, summing to 1 */
+  int dominant_body;             /* the largest share's body */
+} hm_system_spectrum;
+
+/* Speeds of the critical-speed search [m/s]; tol the bisection's final bracket width. */
+typedef struct {
+  double v_min_mps, v_max_mps, v_step_mps, tol_mps;
+} hm_system_critical_options;
+
+/* 100 km/h to 1500 km/h in 5 km/h steps, to 1e-9 km/h. */
+void hm_system_critical_options_default(hm_system_critical_options *opt);
+
+/* Every field present and consistent (dim and n_bodies in range, callbacks set, bodies in range, inertias finite and
+ * >= 0 and at least one > 0); HM_EINVAL otherwise. */
+hm_status hm_system_validate(const hm_system *sys);
+
+/* The spectrum of df/dx at x = 0 and speed_mps (> 0). out untouched on failure. */
+hm_status hm_system_spectrum_at(const hm_system *sys, double speed_mps, hm_system_spectrum *out);
+
+/* The linear critical speed (the first speed from v_min where the largest real part reaches 0) and the spectrum
+ * there (at the bracket's unstable end). HM_ENOCRIT if the origin is already unstable at v_min or still stable at
+ * v_max; HM_EINVAL for inconsistent options. Outputs untouched on failure (at_crit may be NULL). */
+hm_status hm_system_critical_speed(const hm_system *sys, const hm_system_critical_options *opt, double *speed_mps,
+                                   hm_system_spectrum *at_crit);
+
+/* docs/MODEL.md's wheelset as a system: one body ("wheelsets"), its mass and yaw inertia on states 1 and 3. */
+typedef struct {
+  hm_model model; /* the vehicle and its coefficients; the speed is given per call */
+  double inertia[4];
+  int body[4];
+} hm_wheelset_system;
+
+/* Validate veh and fill *ws and *sys (sys points into ws: keep ws). Outputs untouched on failure. */
+hm_status hm_wheelset_system_init(hm_wheelset_system *ws, const hm_vehicle *veh, hm_system *sys);
+
+#ifdef __cplusplus
+}
+#endif
+
+#endif

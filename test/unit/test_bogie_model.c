@@ -1,0 +1,189 @@
+/* bogie.h: the two-axle bogie of issue #28. Checked against the lone wheelset of MODEL.md (the frame held: the same
+ * eigenvalues, each twice, and the closed-form 517.618 km/h), its analytic Jacobian against central differences of
+ * its right-hand side, and its critical speed by eigenvalue bisection against a second method: the growth rate of a
+ * time simulation (classic RK4 of the right-hand side itself, no Jacobian, no LAPACK) on both sides of it. */
+#include <string.h>
+
+#include "hm_test.h"
+#include "hunting_monitor/bogie.h"
+#include "hunting_monitor/linear.h"
+
+/* The default bogie at conicity lambda0, frame free or held: *b, *m and *sys filled. */
+static void default_bogie(double lambda0, int held, hm_bogie *b, hm_bogie_model *m, hm_system *sys) {
+  hm_bogie_default(b);
+  HM_CHECK(hm_vehicle_set_conicity_at_zero(&b->wheelset, lambda0) == HM_OK, "conicity");
+  HM_CHECK(hm_bogie_model_init(m, b, held, sys) == HM_OK, "init");
+  HM_CHECK(sys->dim == (held ? HM_BOGIE_HELD_DIM : HM_BOGIE_DIM), "dimension %zu", sys->dim);
+}
+
+static void held_frame_is_the_lone_wheelset(void) {
+  const double lambdas[] = {0.12, 0.1358, 0.2};
+  for (int k = 0; k < 3; ++k) {
+    hm_bogie b;
+    hm_bogie_model m;
+    hm_system sys;
+    default_bogie(lambdas[k], 1, &b, &m, &sys);
+    const double speeds[] = {200.0, 450.0, 650.0};
+    for (int j = 0; j < 3; ++j) {
+      const double v = hm_mps_from_kmh(speeds[j]);
+      hm_system_spectrum s;
+      double re[4], im[4];
+      HM_CHECK(hm_system_spectrum_at(&sys, v, &s) == HM_OK, "spectrum");
+      HM_CHECK(hm_linear_eigenvalues(&b.wheelset, lambdas[k], v, re, im) == HM_OK, "wheelset");
+      /* each of the wheelset's eigenvalues appears twice */
+      int used[4] = {0, 0, 0, 0};
+      for (int i = 0; i < 8; ++i) {
+        int best = -1;
+        double d_best = INFINITY;
+        for (int q = 0; q < 4; ++q) {
+          const double d = hypot(s.re[i] - re[q], s.im[i] - im[q]);
+          if (d < d_best) d_best = d, best = q;
+        }
+        used[best]++;
+        HM_CHECK(d_best <= 1e-9 * hypot(re[best], im[best]), "eigenvalue %d off by %.3g", i, d_best);
+      }
+      for (int q = 0; q < 4; ++q) HM_CHECK(used[q] == 2, "wheelset eigenvalue %d found %d times", q, used[q]);
+    }
+    hm_system_critical_options opt;
+    hm_system_critical_options_default(&opt);
+    double v = 0.0, v_closed = 0.0;
+    hm_system_spectrum s;
+    HM_CHECK(hm_system_critical_speed(&sys, &opt, &v, &s) == HM_OK, "critical");
+    HM_CHECK(hm_linear_critical_speed(&b.wheelset, lambdas[k], &v_closed) == HM_OK, "closed form");
+    HM_CHECK_REL(v, v_closed, 1e-9, "held frame's critical speed against the closed form");
+    HM_CHECK_DELTA(s.body_share[0], 1.0, 1e-12, "the held frame has no energy");
+    if (lambdas[k] == 0.1358) HM_CHECK_DELTA(hm_kmh_from_mps(v), 517.618, 0.0005, "MODEL.md's 517.618 km/h");
+  }
+}
+
+/* The analytic Jacobian against central differences of the right-hand side, at a state in the nonlinear range
+ * (the conicity's Gaussians and the flange force active). */
+static void jacobian_against_differences(void) {
+  hm_bogie b;
+  hm_bogie_default(&b);
+  for (int held = 0; held <= 1; ++held) {
+    hm_bogie_model m;
+    hm_system sys;
+    HM_CHECK(hm_bogie_model_init(&m, &b, held, &sys) == HM_OK, "init");
+    const size_t n = sys.dim;
+    double x[HM_BOGIE_DIM] = {0.0062, 0.05, 0.0011, -0.02, -0.0048, 0.03, -0.0007, 0.01,
+                              0.0015, -0.004, 0.0003, 0.002, 0.0002};
+    double jac[HM_BOGIE_DIM * HM_BOGIE_DIM], fp[HM_BOGIE_DIM], fm[HM_BOGIE_DIM];
+    const double v = hm_mps_from_kmh(380.0);
+    HM_CHECK(hm_bogie_jacobian(&m, v, x, jac) == HM_OK, "jacobian");
+    for (size_t j = 0; j < n; ++j) {
+      const double h = 1e-7 * fmax(1e-3, fabs(x[j])), xj = x[j];
+      x[j] = xj + h;
+      hm_bogie_rhs(&m, v, x, NULL, fp);
+      x[j] = xj - h;
+      hm_bogie_rhs(&m, v, x, NULL, fm);
+      x[j] = xj;
+      for (size_t i = 0; i < n; ++i) {
+        const double fd = (fp[i] - fm[i]) / (2.0 * h);
+        HM_CHECK(fabs(jac[n * i + j] - fd) <= 1e-6 * fabs(fd) + 1e-3,
+                 "held %d: d f%zu / d x%zu = %.9g, differences %.9g", held, i, j, jac[n * i + j], fd);
+      }
+    }
+  }
+}
+
+/* Growth rate of the linearised motion from the simulation: RK4 of hm_bogie_rhs at 1 ms from a 1e-8 m disturbance
+ * (far inside the linear range), a settling time for the other modes to die out, then the least-squares slope of
+ * ln |x|^2 over the rest, averaged over whole periods by fitting at the peaks' envelope (a period's mean). */
+static double simulated_growth_rate(const hm_bogie_model *m, double v, double settle_s, double span_s) {
+  const size_t n = HM_BOGIE_DIM;
+  double x[HM_BOGIE_DIM] = {1e-8, 0.0, 2e-9, 0.0, -1e-8, 0.0, 1e-9, 0.0, 3e-9, 0.0, 1e-9, 0.0, 0.0};
+  double k1[HM_BOGIE_DIM], k2[HM_BOGIE_DIM], k3[HM_BOGIE_DIM], k4[HM_BOGIE_DIM], t[HM_BOGIE_DIM];
+  const double h = 1e-3, block_s = 1.0;
+  const long steps = (long)((settle_s + span_s) / h), per_block = (long)(block_s / h);
+  double sx = 0.0, sy = 0.0, sxx = 0.0, sxy = 0.0, acc = 0.0, scale = 0.0;
+  int nb = 0;
+  for (long s = 1; s <= steps; ++s) {
+    hm_bogie_rhs(m, v, x, NULL, k1);
+    for (size_t i = 0; i < n; ++i) t[i] = x[i] + 0.5 * h * k1[i];
+    hm_bogie_rhs(m, v, t, NULL, k2);
+    for (size_t i = 0; i < n; ++i) t[i] = x[i] + 0.5 * h * k2[i];
+    hm_bogie_rhs(m, v, t, NULL, k3);
+    for (size_t i = 0; i < n; ++i) t[i] = x[i] + h * k3[i];
+    hm_bogie_rhs(m, v, t, NULL, k4);
+    for (size_t i = 0; i < n; ++i) x[i] += h / 6.0 * (k1[i] + 2.0 * k2[i] + 2.0 * k3[i] + k4[i]);
+    /* renormalise now and then (a growing or dying motion stays in range; the log keeps the total) */
+    const double nx = fabs(x[0]) + fabs(x[4]) + fabs(x[8]);
+    if (nx > 1e-6 || (nx < 1e-12 && nx > 0.0)) {
+      for (size_t i = 0; i < n; ++i) x[i] /= nx / 1e-8;
+      scale += log(nx / 1e-8);
+    }
+    if (s * h > settle_s) {
+      acc += x[0] * x[0] + x[4] * x[4];
+      if (s % per_block == 0) {
+        const double tc = (s - per_block / 2) * h, y = log(acc / per_block) + 2.0 * scale;
+        sx += tc, sy += y, sxx += tc * tc, sxy += tc * y;
+        ++nb;
+        acc = 0.0;
+      }
+    }
+  }
+  const double slope = (nb * sxy - sx * sy) / (nb * sxx - sx * sx);
+  return 0.5 * slope; /* |x|^2 grows at twice the rate */
+}
+
+/* The critical speed by eigenvalues against the simulation: stable 0.1 km/h below it, unstable 0.1 km/h above it,
+ * for a critical mode of the wheelsets (14 Hz at 0.1358) and one of the frame (at 0.30); and the rates 15 km/h off
+ * it within 3% of the eigenvalue's real part. */
+static void critical_speed_against_simulation(void) {
+  const double lambdas[] = {0.1358, 0.30};
+  for (int k = 0; k < 2; ++k) {
+    hm_bogie b;
+    hm_bogie_model m;
+    hm_system sys;
+    default_bogie(lambdas[k], 0, &b, &m, &sys);
+    hm_system_critical_options opt;
+    hm_system_critical_options_default(&opt);
+    double vc = 0.0;
+    hm_system_spectrum s;
+    HM_CHECK(hm_system_critical_speed(&sys, &opt, &vc, &s) == HM_OK, "critical");
+    printf("  conicity %.4f: critical %.4f km/h at %.3f Hz, the mode's energy %.2f in the wheelsets, %.2f in the "
+           "frame\n", lambdas[k], hm_kmh_from_mps(vc), s.frequency_hz, s.body_share[0], s.body_share[1]);
+    const double below = simulated_growth_rate(&m, vc - hm_mps_from_kmh(0.1), 60.0, 240.0);
+    const double above = simulated_growth_rate(&m, vc + hm_mps_from_kmh(0.1), 60.0, 240.0);
+    printf("  simulated growth rates 0.1 km/h below and above: %.5f, %.5f 1/s\n", below, above);
+    HM_CHECK(below < 0.0 && above > 0.0, "the simulation's stability changes within 0.1 km/h of the critical speed");
+    for (int side = -1; side <= 1; side += 2) {
+      const double v = vc + side * hm_mps_from_kmh(15.0);
+      hm_system_spectrum e;
+      HM_CHECK(hm_system_spectrum_at(&sys, v, &e) == HM_OK, "spectrum");
+      const double g = simulated_growth_rate(&m, v, 60.0, 60.0);
+      HM_CHECK_DELTA(g, e.abscissa_1_s, 0.03 * fabs(e.abscissa_1_s), "growth rate 15 km/h off the critical speed");
+    }
+  }
+}
+
+static void bad_parameters(void) {
+  hm_bogie b;
+  hm_bogie_default(&b);
+  char why[160] = "";
+  HM_CHECK(hm_bogie_validate(&b, why, sizeof why) == HM_OK, "defaults valid: %s", why);
+  b.frame_mass_kg = -2600.0;
+  HM_CHECK(hm_bogie_validate(&b, why, sizeof why) == HM_EDOMAIN, "negative frame mass");
+  HM_CHECK(strcmp(why, "bogie.frame_mass_kg: must be > 0 (got -2600)") == 0, "message: %s", why);
+  hm_bogie_default(&b);
+  b.yaw_damper_stiffness_n_m = NAN;
+  HM_CHECK(hm_bogie_validate(&b, why, sizeof why) == HM_EDOMAIN && strstr(why, "yaw_damper_stiffness_n_m"), "NaN");
+  hm_bogie_default(&b);
+  b.secondary_lat_damping_n_s_m = 0.0; /* allowed: no lateral damper */
+  HM_CHECK(hm_bogie_validate(&b, why, sizeof why) == HM_OK, "zero lateral damping allowed");
+  b.wheelset.mass_kg = 0.0;
+  HM_CHECK(hm_bogie_validate(&b, why, sizeof why) == HM_EDOMAIN && strstr(why, "vehicle.mass_kg"), "wheelset: %s", why);
+  hm_bogie_model m;
+  hm_system sys;
+  memset(&m, 0x33, sizeof m);
+  HM_CHECK(hm_bogie_model_init(&m, &b, 0, &sys) == HM_EDOMAIN && ((unsigned char *)&m)[0] == 0x33, "untouched");
+}
+
+int main(void) {
+  HM_RUN(held_frame_is_the_lone_wheelset);
+  HM_RUN(jacobian_against_differences);
+  HM_RUN(critical_speed_against_simulation);
+  HM_RUN(bad_parameters);
+  HM_TEST_EXIT();
+}
