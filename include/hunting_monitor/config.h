@@ -23,12 +23,30 @@
  *
  * Every key of the three sections is required (gaussians may be an empty list or absent); an unknown key
  * inside them is an error; other top-level sections are left to other modules (monitor settings).
+ *
+ * A two-axle bogie (bogie.h; config/bogie_default.yaml) says so at the top level and adds a section, every key
+ * required, SI units as named; its wheelsets are the three sections above:
+ *   model: bogie                    # absent or `wheelset`: the wheelset above
+ *   bogie:
+ *     frame_mass_kg: 2600
+ *     frame_yaw_inertia_kg_m2: 1800
+ *     half_wheelbase_m: 1.25
+ *     secondary_lat_stiffness_n_m: 2.5e5
+ *     secondary_lat_damping_n_s_m: 3e4
+ *     airspring_long_stiffness_n_m: 1.5e5   # each of two, at lateral arm airspring_half_distance_m
+ *     airspring_half_distance_m: 1.0
+ *     yaw_damper_damping_n_s_m: 1e6          # each of two, in series with yaw_damper_stiffness_n_m,
+ *     yaw_damper_stiffness_n_m: 5e7          # at lateral arm yaw_damper_half_distance_m
+ *     yaw_damper_half_distance_m: 1.3
+ * The wheelset's reader refuses a bogie config (and the bogie's a wheelset config): a model is never taken for
+ * another silently.
  */
 #ifndef HUNTING_MONITOR_CONFIG_H
 #define HUNTING_MONITOR_CONFIG_H
 
 #include <stddef.h>
 
+#include "hunting_monitor/bogie.h"
 #include "hunting_monitor/monitor.h"
 #include "hunting_monitor/model.h"
 #include "hunting_monitor/status.h"
@@ -50,6 +68,18 @@ hm_status hm_config_parse_vehicle(const char *text, size_t len, const char *sour
 
 /* Read the file at path and parse it as above; HM_EIO if it cannot be read. */
 hm_status hm_config_load_vehicle(const char *path, hm_vehicle *veh, char *name, char *err, size_t err_len);
+
+/* Which model a vehicle config describes (its `model:` key; absent: the wheelset). HM_EPARSE for another value or
+ * malformed YAML. */
+hm_status hm_config_model_kind(const char *text, size_t len, const char *source, hm_model_kind *kind, char *err,
+                               size_t err_len);
+hm_status hm_config_load_model_kind(const char *path, hm_model_kind *kind, char *err, size_t err_len);
+
+/* A bogie config (above): as hm_config_parse_vehicle, then the bogie section, then hm_bogie_validate. Outputs
+ * untouched on failure. */
+hm_status hm_config_parse_bogie(const char *text, size_t len, const char *source, hm_bogie *bogie, char *name,
+                                char *err, size_t err_len);
+hm_status hm_config_load_bogie(const char *path, hm_bogie *bogie, char *name, char *err, size_t err_len);
 
 /*
  * Monitor settings (config/monitor.yaml): optional sections `estimator:`, `modal:`, `margin:`, `alarm:` and `table:`

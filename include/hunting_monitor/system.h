@@ -25,6 +25,15 @@ extern "C" {
 #endif
 
 #define HM_SYSTEM_MAX_DIM 40
+
+/* The vehicle models the core holds (a vehicle config's `model:` key). */
+typedef enum {
+  HM_MODEL_WHEELSET = 0, /* docs/MODEL.md's wheelset on fixed springs (model.h) */
+  HM_MODEL_BOGIE = 1     /* two such wheelsets on a bogie frame (bogie.h) */
+} hm_model_kind;
+
+/* "wheelset", "bogie"; "unknown" otherwise. */
+const char *hm_model_kind_name(hm_model_kind kind);
 #define HM_SYSTEM_MAX_BODIES 4
 
 /* f(x; v) and df/dx (row-major, dim x dim: jac[dim * i + j] = d f_i / d x_j) of the model's parameters at speed v

@@ -130,7 +130,12 @@ int cli_vehicle(const cli_args *a, hm_vehicle *veh, char *name) {
   if (path) {
     hm_status st = hm_config_load_vehicle(path, &v, name, err, sizeof err);
     if (st != HM_OK) {
-      fprintf(stderr, "hunting: config error: %s\n", err);
+      hm_model_kind kind = HM_MODEL_WHEELSET;
+      const int other_model = hm_config_load_model_kind(path, &kind, NULL, 0) == HM_OK && kind != HM_MODEL_WHEELSET;
+      fprintf(stderr, "hunting: config error: %s%s\n", err,
+              other_model ? " (this command takes the wheelset model; `hunting critical` and `hunting eig` take a "
+                            "bogie)"
+                          : "");
       return 1;
     }
   } else {
@@ -151,6 +156,52 @@ int cli_vehicle(const cli_args *a, hm_vehicle *veh, char *name) {
   }
   *veh = v;
   return 0;
+}
+
+int cli_model_kind(const cli_args *a, hm_model_kind *kind) {
+  const char *path = cli_value(a, "config");
+  char err[512];
+  *kind = HM_MODEL_WHEELSET;
+  if (!path) return 0;
+  if (hm_config_load_model_kind(path, kind, err, sizeof err) != HM_OK) {
+    fprintf(stderr, "hunting: config error: %s\n", err);
+    return 1;
+  }
+  return 0;
+}
+
+int cli_bogie(const cli_args *a, hm_bogie *bogie, char *name) {
+  hm_bogie b;
+  char err[512];
+  const char *path = cli_value(a, "config");
+  if (!path || hm_config_load_bogie(path, &b, name, err, sizeof err) != HM_OK) {
+    fprintf(stderr, "hunting: config error: %s\n", path ? err : "a bogie needs --config FILE");
+    return 1;
+  }
+  hm_vehicle *w = &b.wheelset;
+  double kx = w->stiffness_long_n_m / 1e6, ky = w->stiffness_lat_n_m / 1e6, lambda0 = cli_conicity0(w);
+  if (cli_number(a, "kx", &kx) || cli_number(a, "ky", &ky) || cli_number(a, "conicity", &lambda0)) return 1;
+  w->stiffness_long_n_m = kx * 1e6;
+  w->stiffness_lat_n_m = ky * 1e6;
+  if (hm_vehicle_set_conicity_at_zero(w, lambda0) != HM_OK) {
+    fprintf(stderr, "hunting: --conicity %g: must be >= 0 and >= the Gaussian terms' value at y = 0\n", lambda0);
+    return 1;
+  }
+  if (hm_bogie_validate(&b, err, sizeof err) != HM_OK) {
+    fprintf(stderr, "hunting: invalid bogie: %s\n", err);
+    return 1;
+  }
+  *bogie = b;
+  return 0;
+}
+
+void jw_spectrum(json_writer *w, const char *key, const hm_system_spectrum *s) {
+  jw_array(w, key);
+  for (size_t i = 0; i < s->dim; ++i) {
+    const double pair[2] = {s->re[i], s->im[i]};
+    jw_numbers(w, NULL, pair, 2);
+  }
+  jw_end_array(w);
 }
 
 double cli_conicity0(const hm_vehicle *veh) {

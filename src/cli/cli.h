@@ -4,7 +4,9 @@
 
 #include <stdio.h>
 
+#include "hunting_monitor/bogie.h"
 #include "hunting_monitor/model.h"
+#include "hunting_monitor/system.h"
 
 /* One option of a command: --name takes a value unless is_flag. */
 typedef struct {
@@ -39,6 +41,10 @@ int cli_number_list(const cli_args *a, const char *name, double *out, int n);
 int cli_vehicle(const cli_args *a, hm_vehicle *veh, char *name);
 /* lambda(0) of the vehicle after overrides. */
 double cli_conicity0(const hm_vehicle *veh);
+/* The model --config describes (none: the wheelset); 1 after printing the config's error. */
+int cli_model_kind(const cli_args *a, hm_model_kind *kind);
+/* The bogie of --config with --kx, --ky, --conicity applied to its wheelsets, validated; 1 after printing why not. */
+int cli_bogie(const cli_args *a, hm_bogie *bogie, char *name);
 
 void cli_print_help(FILE *f, const char *command, const char *usage, const char *summary, const cli_option *opts);
 
@@ -68,6 +74,8 @@ void jw_bool(json_writer *w, const char *key, int value);
 /* An array of n numbers; the eigenvalues as [[re, im], ...]. */
 void jw_numbers(json_writer *w, const char *key, const double *x, size_t n);
 void jw_eigenvalues(json_writer *w, const char *key, const double re[4], const double im[4]);
+/* A spectrum's eigenvalues as [re, im] pairs. */
+void jw_spectrum(json_writer *w, const char *key, const hm_system_spectrum *s);
 /* Ends the document with a newline. */
 void jw_finish(json_writer *w);
 

@@ -204,12 +204,33 @@ static hm_status parse_flange_section(parse_ctx *c, yaml_node_t *sec, hm_vehicle
   return st;
 }
 
-static hm_status parse_document(parse_ctx *c, hm_vehicle *veh, char *name) {
+/* The top-level `model:` key: wheelset (also when absent) or bogie. */
+static hm_status parse_model_kind(parse_ctx *c, yaml_node_t *root, hm_model_kind *kind) {
+  yaml_node_t *n = map_get(c, root, "model");
+  *kind = HM_MODEL_WHEELSET;
+  if (!n) return HM_OK;
+  if (n->type == YAML_SCALAR_NODE && strcmp(scalar_text(n), "wheelset") == 0) return HM_OK;
+  if (n->type == YAML_SCALAR_NODE && strcmp(scalar_text(n), "bogie") == 0) {
+    *kind = HM_MODEL_BOGIE;
+    return HM_OK;
+  }
+  return fail(c, n, HM_EPARSE, "model: expected wheelset or bogie, got '%s'",
+              n->type == YAML_SCALAR_NODE ? scalar_text(n) : "(not a name)");
+}
+
+/* The wheelset's sections (vehicle, conicity, flange); the document's model kind must be want. */
+static hm_status parse_document(parse_ctx *c, hm_model_kind want, hm_vehicle *veh, char *name) {
   yaml_node_t *root = yaml_document_get_root_node(c->doc);
   if (!root) return fail(c, NULL, HM_EPARSE, "empty document");
   if (root->type != YAML_MAPPING_NODE) return fail(c, root, HM_EPARSE, "expected a mapping at the top level");
+  hm_model_kind kind;
+  hm_status st = parse_model_kind(c, root, &kind);
+  if (st != HM_OK) return st;
+  if (kind != want)
+    return fail(c, map_get(c, root, "model"), HM_EPARSE, "model: '%s' where a %s config is expected",
+                hm_model_kind_name(kind), hm_model_kind_name(want));
   yaml_node_t *sv, *sc, *sf;
-  hm_status st = get_section(c, root, "vehicle", &sv);
+  st = get_section(c, root, "vehicle", &sv);
   if (st == HM_OK) st = get_section(c, root, "conicity", &sc);
   if (st == HM_OK) st = get_section(c, root, "flange", &sf);
   if (st == HM_OK) st = parse_vehicle_section(c, sv, veh, name);
@@ -244,7 +265,7 @@ hm_status hm_config_parse_vehicle(const char *text, size_t len, const char *sour
   hm_vehicle out;
   hm_vehicle_default(&out);
   char out_name[HM_VEHICLE_NAME_MAX];
-  hm_status st = parse_document(&c, &out, out_name);
+  hm_status st = parse_document(&c, HM_MODEL_WHEELSET, &out, out_name);
   if (st == HM_OK) {
     char why[160];
     st = hm_vehicle_validate(&out, why, sizeof why);
@@ -284,16 +305,115 @@ static hm_status read_small_file(parse_ctx *c, const char *path, char **text, si
   return HM_OK;
 }
 
-hm_status hm_config_load_vehicle(const char *path, hm_vehicle *veh, char *name, char *err, size_t err_len) {
+/* ---- the bogie (bogie.h) ---- */
+
+static hm_status parse_bogie_section(parse_ctx *c, yaml_node_t *sec, hm_bogie *b) {
+#define BF(f) {#f, 0, offsetof(hm_bogie, f)}
+  static const number_field fields[] = {
+      BF(frame_mass_kg),
+      BF(frame_yaw_inertia_kg_m2),
+      BF(half_wheelbase_m),
+      BF(secondary_lat_stiffness_n_m),
+      BF(secondary_lat_damping_n_s_m),
+      BF(airspring_long_stiffness_n_m),
+      BF(airspring_half_distance_m),
+      BF(yaw_damper_damping_n_s_m),
+      BF(yaw_damper_stiffness_n_m),
+      BF(yaw_damper_half_distance_m),
+  };
+#undef BF
+  enum { N_FIELDS = sizeof fields / sizeof fields[0] };
+  const char *allowed[N_FIELDS + 1];
+  for (size_t i = 0; i < N_FIELDS; ++i) allowed[i] = fields[i].key;
+  allowed[N_FIELDS] = NULL;
+  hm_status st = check_keys(c, sec, "bogie", allowed);
+  for (size_t i = 0; st == HM_OK && i < N_FIELDS; ++i)
+    st = get_number(c, sec, "bogie", fields[i].key, (double *)((char *)b + fields[i].offset));
+  return st;
+}
+
+hm_status hm_config_model_kind(const char *text, size_t len, const char *source, hm_model_kind *kind, char *err,
+                               size_t err_len) {
+  parse_ctx c = {NULL, source ? source : "<config>", err, err_len};
+  if (!text || !kind) return fail(&c, NULL, HM_EINVAL, "no text or no output");
+  yaml_document_t doc;
+  hm_status st = load_document(&c, text, len, &doc);
+  if (st != HM_OK) return st;
+  yaml_node_t *root = yaml_document_get_root_node(&doc);
+  hm_model_kind k = HM_MODEL_WHEELSET;
+  if (!root) st = fail(&c, NULL, HM_EPARSE, "empty document");
+  else if (root->type != YAML_MAPPING_NODE) st = fail(&c, root, HM_EPARSE, "expected a mapping at the top level");
+  else st = parse_model_kind(&c, root, &k);
+  yaml_document_delete(&doc);
+  if (st == HM_OK) *kind = k;
+  return st;
+}
+
+hm_status hm_config_parse_bogie(const char *text, size_t len, const char *source, hm_bogie *bogie, char *name,
+                                char *err, size_t err_len) {
+  parse_ctx c = {NULL, source ? source : "<config>", err, err_len};
+  if (!text || !bogie) return fail(&c, NULL, HM_EINVAL, "no text or no output");
+  yaml_document_t doc;
+  hm_status st = load_document(&c, text, len, &doc);
+  if (st != HM_OK) return st;
+  hm_bogie out;
+  hm_bogie_default(&out);
+  char out_name[HM_VEHICLE_NAME_MAX];
+  yaml_node_t *sb = NULL;
+  st = parse_document(&c, HM_MODEL_BOGIE, &out.wheelset, out_name);
+  if (st == HM_OK) st = get_section(&c, yaml_document_get_root_node(&doc), "bogie", &sb);
+  if (st == HM_OK) st = parse_bogie_section(&c, sb, &out);
+  if (st == HM_OK) {
+    char why[160];
+    st = hm_bogie_validate(&out, why, sizeof why);
+    if (st != HM_OK) fail(&c, NULL, st, "%s", why);
+  }
+  yaml_document_delete(&doc);
+  if (st != HM_OK) return st;
+  *bogie = out;
+  if (name) memcpy(name, out_name, HM_VEHICLE_NAME_MAX);
+  return HM_OK;
+}
+
+/* Read path and hand its text to parse (one of the three readers above, through a small adapter). */
+typedef hm_status (*text_reader)(const char *text, size_t len, const char *source, void *out, char *name, char *err,
+                                 size_t err_len);
+
+static hm_status load_with(const char *path, text_reader parse, void *out, char *name, char *err, size_t err_len) {
   parse_ctx c = {NULL, path ? path : "<null>", err, err_len};
   if (!path) return fail(&c, NULL, HM_EINVAL, "no path");
   char *buf = NULL;
   size_t n = 0;
   hm_status st = read_small_file(&c, path, &buf, &n);
   if (st != HM_OK) return st;
-  st = hm_config_parse_vehicle(buf, n, path, veh, name, err, err_len);
+  st = parse(buf, n, path, out, name, err, err_len);
   free(buf);
   return st;
+}
+
+static hm_status read_kind(const char *t, size_t n, const char *src, void *out, char *name, char *e, size_t el) {
+  (void)name;
+  return hm_config_model_kind(t, n, src, (hm_model_kind *)out, e, el);
+}
+
+static hm_status read_bogie(const char *t, size_t n, const char *src, void *out, char *name, char *e, size_t el) {
+  return hm_config_parse_bogie(t, n, src, (hm_bogie *)out, name, e, el);
+}
+
+static hm_status read_vehicle(const char *t, size_t n, const char *src, void *out, char *name, char *e, size_t el) {
+  return hm_config_parse_vehicle(t, n, src, (hm_vehicle *)out, name, e, el);
+}
+
+hm_status hm_config_load_vehicle(const char *path, hm_vehicle *veh, char *name, char *err, size_t err_len) {
+  return load_with(path, read_vehicle, veh, name, err, err_len);
+}
+
+hm_status hm_config_load_model_kind(const char *path, hm_model_kind *kind, char *err, size_t err_len) {
+  return load_with(path, read_kind, kind, NULL, err, err_len);
+}
+
+hm_status hm_config_load_bogie(const char *path, hm_bogie *bogie, char *name, char *err, size_t err_len) {
+  return load_with(path, read_bogie, bogie, name, err, err_len);
 }
 
 /* ---- monitor settings ---- */

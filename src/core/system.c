@@ -10,6 +10,10 @@
 
 enum { N_MAX = HM_SYSTEM_MAX_DIM, LWORK = 8 * HM_SYSTEM_MAX_DIM };
 
+const char *hm_model_kind_name(hm_model_kind kind) {
+  return kind == HM_MODEL_WHEELSET ? "wheelset" : kind == HM_MODEL_BOGIE ? "bogie" : "unknown";
+}
+
 void hm_system_critical_options_default(hm_system_critical_options *opt) {
   opt->v_min_mps = hm_mps_from_kmh(100.0);
   opt->v_max_mps = hm_mps_from_kmh(1500.0);

@@ -953,6 +953,87 @@ def test_independent_sim_sample_rates():
         close(got[fs]["frequency_hz"], got[2000]["frequency_hz"], 0.01 * got[2000]["frequency_hz"], f"frequency at {fs} Hz")
 
 
+def bogie_matrix(v, lam, kx=8.96e6, ky=8.96e6):
+    """The linearised bogie of bogie.h written again here from its header's equations (the defaults of
+    config/bogie_default.yaml): the 13 x 13 matrix at speed v [m/s] and conicity lam."""
+    import numpy as np
+    m, I, d0, d1, r0, f, ratio = 1869.0, 910.0, 0.7465, 1.0, 0.43, 7.99e6, 1.351186
+    mf, jf, b, ksy, csy, ka, da, cd, kd, dd = 2600.0, 1800.0, 1.25, 2.5e5, 3e4, 1.5e5, 1.0, 1e6, 5e7, 1.3
+    kg = kx * (ratio - 1.0)
+    n = 13
+    # the equations as forces: M x'' = ... ; row by row, states y1 y1' p1 p1' y2 y2' p2 p2' yf yf' pf pf' u
+    A = np.zeros((n, n))
+    xs = (b, -b)
+    for i in range(2):
+        o = 4 * i
+        A[o, o + 1] = 1.0
+        A[o + 2, o + 3] = 1.0
+        # m y'' = -2f/v y' + 2f psi - kg y - ky (y - yf - x psif)
+        A[o + 1, [o, o + 1, o + 2, 8, 10]] = np.array([-kg - ky, -2 * f / v, 2 * f, ky, ky * xs[i]]) / m
+        # I psi'' = -2 f d0 lam / r0 y - 2 f d0^2 / v psi' - kx d1^2 (psi - psif)
+        A[o + 3, [o, o + 2, o + 3, 10]] = np.array([-2 * f * d0 * lam / r0, -kx * d1 ** 2, -2 * f * d0 ** 2 / v,
+                                                    kx * d1 ** 2]) / I
+    A[8, 9] = 1.0
+    A[10, 11] = 1.0
+    for i in range(2):
+        o = 4 * i
+        A[9, o] += ky / mf
+        A[9, 8] -= ky / mf
+        A[9, 10] -= ky * xs[i] / mf
+        A[11, o] += xs[i] * ky / jf
+        A[11, o + 2] += kx * d1 ** 2 / jf
+        A[11, 8] -= xs[i] * ky / jf
+        A[11, 10] -= (xs[i] ** 2 * ky + kx * d1 ** 2) / jf
+    A[9, 8] -= ksy / mf
+    A[9, 9] -= csy / mf
+    A[11, 10] -= (2 * ka * da ** 2 + 2 * dd ** 2 * kd) / jf
+    A[11, 12] += 2 * dd * kd / jf
+    A[12, 10] = kd * dd / cd
+    A[12, 12] = -kd / cd
+    return A
+
+
+def test_bogie_critical_and_eig():
+    """`hunting critical` and `eig` on config/bogie_default.yaml against a second implementation (numpy's eigvals of
+    bogie_matrix, bisected here), and the frame held against MODEL.md's 517.618 km/h."""
+    import numpy as np
+    cfg = os.path.join(SRC, "config", "bogie_default.yaml")
+
+    def abscissa(v_kmh, lam):
+        e = np.linalg.eigvals(bogie_matrix(v_kmh / 3.6, lam))
+        k = int(np.argmax(e.real))
+        return e[k].real, abs(e[k].imag) / (2 * math.pi)
+
+    for lam in (0.1358, 0.2, 0.3):
+        out = run_json("critical", "--config", cfg, "--conicity", str(lam))
+        assert out["model"] == "bogie", out
+        lo, hi = 100.0, 100.0
+        while abscissa(hi, lam)[0] < 0:
+            lo, hi = hi, hi + 5.0
+        for _ in range(50):
+            mid = 0.5 * (lo + hi)
+            lo, hi = (mid, hi) if abscissa(mid, lam)[0] < 0 else (lo, mid)
+        close(out["v_crit_kmh"], hi, 1e-4, f"bogie critical speed at {lam}")
+        close(out["frequency_hz"], abscissa(hi, lam)[1], 1e-4, f"bogie critical frequency at {lam}")
+        shares = out["mode_energy_share"]
+        close(shares["wheelsets"] + shares["bogie frame"], 1.0, 1e-12, "energy shares")
+        assert out["mode"] == max(shares, key=shares.get), out
+    close(run_json("critical", "--config", cfg)["frame_held_v_crit_kmh"], 517.618, 6e-4, "the frame held")
+    eig = run_json("eig", "--config", cfg, "--v", "450")
+    ref = sorted(np.linalg.eigvals(bogie_matrix(450 / 3.6, 0.1358)), key=lambda z: (-z.real, -z.imag))
+    assert len(eig["eigenvalues"]) == 13 and eig["stable"] is True, eig
+    for (re, im), z in zip(eig["eigenvalues"], ref):
+        close(re, z.real, 1e-7 * abs(z), "bogie eigenvalue (real)")
+        close(im, z.imag, 1e-7 * abs(z), "bogie eigenvalue (imaginary)")
+    # a bogie config where a wheelset is expected, and a bad bogie: clear errors
+    p = run("simulate", "--config", cfg, "--v", "300", ok=False)
+    assert p.returncode != 0 and "model: 'bogie' where a wheelset config is expected" in p.stderr, p.stderr
+    with tempfile.TemporaryDirectory() as d:
+        bad = write_file(d, "bad.yaml", open(cfg).read().replace("frame_mass_kg: 2600", "frame_mass_kg: -5"))
+        p = run("critical", "--config", bad, ok=False)
+        assert p.returncode != 0 and "bogie.frame_mass_kg: must be > 0 (got -5)" in p.stderr, p.stderr
+
+
 def main():
     global failures
     tests = [(n, f) for n, f in globals().items() if n.startswith("test_") and callable(f)]

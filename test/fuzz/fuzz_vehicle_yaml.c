@@ -1,5 +1,5 @@
-/* libFuzzer harness: the vehicle YAML parser, and the writer's promise that parsing its output gives back the same
- * doubles. */
+/* libFuzzer harness: the vehicle YAML parsers (the model kind, the bogie's, the wheelset's), and the writer's promise
+ * that parsing its output gives back the same doubles. */
 #include <stdint.h>
 #include <stdlib.h>
 #include <string.h>
@@ -9,6 +9,12 @@
 int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size) {
   hm_vehicle v, back;
   char name[HM_VEHICLE_NAME_MAX], err[256];
+  hm_model_kind kind;
+  hm_bogie bogie;
+  const hm_status kst = hm_config_model_kind((const char *)data, size, "fuzz", &kind, err, sizeof err);
+  const hm_status bst = hm_config_parse_bogie((const char *)data, size, "fuzz", &bogie, name, err, sizeof err);
+  if (bst == HM_OK && (hm_bogie_validate(&bogie, NULL, 0) != HM_OK || kst != HM_OK || kind != HM_MODEL_BOGIE))
+    __builtin_trap(); /* parsed means valid, and a bogie */
   if (hm_config_parse_vehicle((const char *)data, size, "fuzz", &v, name, err, sizeof err) != HM_OK) return 0;
   if (hm_vehicle_validate(&v, NULL, 0) != HM_OK) __builtin_trap(); /* parsed means valid */
   size_t need = 0;

@@ -232,6 +232,71 @@ static void monitor_settings(void) {
   }
 }
 
+/* The bogie (issue #28): the shipped config/bogie_default.yaml holds hm_bogie_default's values; the two readers
+ * refuse each other's configs; the bogie section's errors are located like the wheelset's. */
+static void bogie_configs(void) {
+  hm_bogie b, d;
+  char name[HM_VEHICLE_NAME_MAX], err[256] = "";
+  HM_CHECK(hm_config_load_bogie(HM_SOURCE_DIR "/config/bogie_default.yaml", &b, name, err, sizeof err) == HM_OK,
+           "load: %s", err);
+  hm_bogie_default(&d);
+  HM_CHECK(strcmp(name, "bogie_default") == 0, "name '%s'", name);
+  HM_CHECK(b.frame_mass_kg == 2600 && b.frame_yaw_inertia_kg_m2 == 1800 && b.half_wheelbase_m == 1.25, "frame");
+  HM_CHECK(b.secondary_lat_stiffness_n_m == 2.5e5 && b.secondary_lat_damping_n_s_m == 3e4, "secondary lateral");
+  HM_CHECK(b.airspring_long_stiffness_n_m == 1.5e5 && b.airspring_half_distance_m == 1.0, "air springs");
+  HM_CHECK(b.yaw_damper_damping_n_s_m == 1e6 && b.yaw_damper_stiffness_n_m == 5e7 &&
+               b.yaw_damper_half_distance_m == 1.3, "yaw dampers");
+  HM_CHECK(memcmp(&b, &d, sizeof b) == 0, "the shipped bogie and hm_bogie_default differ");
+  hm_model_kind kind = HM_MODEL_WHEELSET;
+  HM_CHECK(hm_config_load_model_kind(HM_SOURCE_DIR "/config/bogie_default.yaml", &kind, err, sizeof err) == HM_OK &&
+               kind == HM_MODEL_BOGIE, "kind of the bogie: %s", err);
+  HM_CHECK(hm_config_load_model_kind(HM_SOURCE_DIR "/config/crh380_default.yaml", &kind, err, sizeof err) == HM_OK &&
+               kind == HM_MODEL_WHEELSET, "kind of the wheelset: %s", err);
+  hm_vehicle v;
+  HM_CHECK(hm_config_load_vehicle(HM_SOURCE_DIR "/config/bogie_default.yaml", &v, name, err, sizeof err) ==
+                   HM_EPARSE && strstr(err, "model: 'bogie' where a wheelset config is expected"),
+           "the wheelset reader on a bogie: %s", err);
+  HM_CHECK(hm_config_load_bogie(HM_SOURCE_DIR "/config/crh380_default.yaml", &b, name, err, sizeof err) ==
+                   HM_EPARSE && strstr(err, "model: 'wheelset' where a bogie config is expected"),
+           "the bogie reader on a wheelset: %s", err);
+  const char *bogie_text = "model: bogie\n"
+                           "bogie:\n"
+                           "  frame_mass_kg: 2600\n  frame_yaw_inertia_kg_m2: 1800\n  half_wheelbase_m: 1.25\n"
+                           "  secondary_lat_stiffness_n_m: 2.5e5\n  secondary_lat_damping_n_s_m: 3e4\n"
+                           "  airspring_long_stiffness_n_m: 1.5e5\n  airspring_half_distance_m: 1.0\n"
+                           "  yaw_damper_damping_n_s_m: 1e6\n  yaw_damper_stiffness_n_m: 5e7\n"
+                           "  yaw_damper_half_distance_m: 1.3\n";
+  const struct {
+    const char *from, *to, *message;
+    hm_status status;
+  } cases[] = {
+      {"  frame_mass_kg: 2600\n", "  frame_mass_kg: -2600\n", "bogie.frame_mass_kg: must be > 0 (got -2600)",
+       HM_EDOMAIN},
+      {"  frame_mass_kg: 2600\n", "", "bogie.frame_mass_kg: missing key", HM_EPARSE},
+      {"  half_wheelbase_m: 1.25\n", "  half_wheelbase: 1.25\n", "bogie.half_wheelbase: unknown key", HM_EPARSE},
+      {"  yaw_damper_stiffness_n_m: 5e7\n", "  yaw_damper_stiffness_n_m: stiff\n",
+       "bogie.yaw_damper_stiffness_n_m: expected a finite number", HM_EPARSE},
+      {"model: bogie\n", "model: tram\n", "model: expected wheelset or bogie, got 'tram'", HM_EPARSE},
+      {"model: bogie\nbogie:\n", "model: bogie\nbogies:\n", "bogie: missing section", HM_EPARSE},
+  };
+  /* the wheelset's sections of VALID (without its monitor section), then the bogie's */
+  char base[4096];
+  snprintf(base, sizeof base, "%.*s%s", (int)(strstr(VALID, "monitor:") - VALID), VALID, bogie_text);
+  HM_CHECK(hm_config_parse_bogie(base, strlen(base), "t", &b, NULL, err, sizeof err) == HM_OK, "base: %s", err);
+  for (size_t i = 0; i < sizeof cases / sizeof cases[0]; ++i) {
+    char text[4096];
+    const char *p = strstr(base, cases[i].from);
+    HM_CHECK(p != NULL, "case %zu: test bug", i);
+    if (!p) continue;
+    snprintf(text, sizeof text, "%.*s%s%s", (int)(p - base), base, cases[i].to, p + strlen(cases[i].from));
+    memset(&b, 0x11, sizeof b);
+    const hm_bogie before = b;
+    const hm_status st = hm_config_parse_bogie(text, strlen(text), "t", &b, NULL, err, sizeof err);
+    HM_CHECK(st == cases[i].status && strstr(err, cases[i].message), "case %zu: %s: '%s'", i, hm_status_str(st), err);
+    HM_CHECK(memcmp(&b, &before, sizeof b) == 0, "case %zu: output changed on failure", i);
+  }
+}
+
 int main(void) {
   HM_RUN(monitor_settings);
   HM_RUN(format_round_trip);
@@ -239,5 +304,6 @@ int main(void) {
   HM_RUN(valid_text_parses_with_units);
   HM_RUN(malformed_configs_get_clear_errors);
   HM_RUN(degenerate_documents);
+  HM_RUN(bogie_configs);
   HM_TEST_EXIT();
 }
