@@ -11,7 +11,9 @@
 #include "hunting_monitor/eqcon.h"
 #include "hunting_monitor/estimator.h"
 #include "hunting_monitor/cycles.h"
+#include "hunting_monitor/bogie.h"
 #include "hunting_monitor/hopf.h"
+#include "hunting_monitor/system_cycles.h"
 #include "hunting_monitor/tables.h"
 
 #include "hunting_monitor/integrate.h"
@@ -75,6 +77,36 @@ static double bench_family(size_t *n_points) {
   const double dt = now_s() - t0;
   free(pts);
   return dt;
+}
+
+/* The default bogie's family (config/bogie_default.yaml, 13 states), 150..700 km/h up to 16 mm, from its parameters
+ * (the Hopf point by eigenvalues included), the best of three; and the lone wheelset's same family through the same
+ * generic engine (system_cycles.h) beside its own 4-state engine (bench_family). */
+static double bench_system_family(int bogie, size_t *n_points, size_t *n_folds) {
+  enum { CAP = 5000 };
+  hm_system_cycle_point *pts = malloc(CAP * sizeof *pts);
+  hm_system_cycle_event ev[64];
+  double best = INFINITY;
+  for (int rep = 0; rep < 3 && pts; ++rep) {
+    const double t0 = now_s();
+    hm_bogie b;
+    hm_bogie_default(&b);
+    hm_bogie_model m;
+    hm_wheelset_system ws;
+    hm_system sys;
+    if (bogie) hm_bogie_model_init(&m, &b, 0, &sys);
+    else hm_wheelset_system_init(&ws, &b.wheelset, &sys);
+    hm_system_cycle_options o;
+    hm_system_cycle_options_default(&o);
+    o.v_min_kmh = 150.0, o.v_max_kmh = 700.0, o.amp_max_m = 0.016;
+    size_t ne = 0;
+    hm_system_cycles_continue(&sys, &o, pts, CAP, n_points, ev, 64, &ne, NULL);
+    best = fmin(best, now_s() - t0);
+    *n_folds = 0;
+    for (size_t i = 0; i < ne; ++i) *n_folds += ev[i].kind == HM_CYCLE_LPC;
+  }
+  free(pts);
+  return best;
 }
 
 /* LPC curve over Kx in [9.0, 10.7] at Ky = 10.96 from the parameters: Hopf point, family to 7.5 mm, the folds,
@@ -377,6 +409,9 @@ int main(void) {
   size_t family_points = 0, lpc_points = 0, table_bytes = 0;
   const double folds_s = bench_folds(20, &lpc1, &lpc2);
   const double family_s = bench_family(&family_points);
+  size_t bogie_points = 0, bogie_folds = 0, ws_generic_points = 0, ws_generic_folds = 0;
+  const double bogie_family_s = bench_system_family(1, &bogie_points, &bogie_folds);
+  const double ws_generic_s = bench_system_family(0, &ws_generic_points, &ws_generic_folds);
   const double lpc_s = bench_lpc_curve(&cusp_kx, &lpc_points);
   bench_table(&parse_us, &lookup_ns, &table_bytes);
   double fit_rmse = 0.0;
@@ -400,6 +435,11 @@ int main(void) {
   printf("  \"folds_kx9.7_kmh\": [%.6f, %.6f],\n", lpc1, lpc2);
   printf("  \"whole_family_default_vehicle_ms\": %.4g,\n", family_s * 1e3);
   printf("  \"whole_family_points\": %zu,\n", family_points);
+  printf("  \"whole_family_default_vehicle_generic_engine_ms\": %.4g,\n", ws_generic_s * 1e3);
+  printf("  \"whole_family_generic_engine_points\": %zu,\n", ws_generic_points);
+  printf("  \"bogie_family_150_700_kmh_ms\": %.4g,\n", bogie_family_s * 1e3);
+  printf("  \"bogie_family_points\": %zu,\n", bogie_points);
+  printf("  \"bogie_family_folds\": %zu,\n", bogie_folds);
   printf("  \"lpc_curve_kx_9.0_10.7_ms\": %.4g,\n", lpc_s * 1e3);
   printf("  \"lpc_curve_points\": %zu,\n", lpc_points);
   printf("  \"lpc_curve_cusp_kx\": %.6f,\n", cusp_kx);

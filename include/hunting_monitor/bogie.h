@@ -68,17 +68,21 @@ typedef struct {
   hm_bogie bogie;
   hm_linear_coef coef;  /* the wheelset's coefficients (MODEL.md section 2) */
   int frame_held;       /* 1: the frame held at rest, 8 states */
-  double inertia[HM_BOGIE_DIM];
+  double inertia[HM_BOGIE_DIM], scale[HM_BOGIE_DIM];
   int body[HM_BOGIE_DIM];
 } hm_bogie_model;
 
-/* Validate and fill *m and *sys (sys points into m: keep m). Bodies: 0 "wheelsets", 1 "bogie frame". */
+/* Validate and fill *m and *sys (sys points into m: keep m). Bodies: 0 "wheelsets", 1 "bogie frame"; a cycle's
+ * amplitude is the leading wheelset's y; odd when lambda(y) is even. */
 hm_status hm_bogie_model_init(hm_bogie_model *m, const hm_bogie *bogie, int frame_held, hm_system *sys);
 
 /* f(x; v) at track displacements y_track[2] under the two wheelsets (NULL: 0): lambda and F_T act on y_i - y_track_i.
  * (system.h's rhs is this with no track.) HM_ENONFINITE if a derivative is not finite. */
 hm_status hm_bogie_rhs(const hm_bogie_model *m, double speed_mps, const double *x, const double *y_track_m,
                        double *dxdt);
+
+/* df/dv [per m/s] (the creep damping's 1/v terms). */
+hm_status hm_bogie_dfdv(const hm_bogie_model *m, double speed_mps, const double *x, double *dfdv);
 
 /* df/dx (row-major, dim x dim, dim 13 or 8 with the frame held), analytic. */
 hm_status hm_bogie_jacobian(const hm_bogie_model *m, double speed_mps, const double *x, double *jac);

@@ -40,16 +40,23 @@ const char *hm_model_kind_name(hm_model_kind kind);
  * [m/s]. HM_ENONFINITE if a value is not finite. */
 typedef hm_status (*hm_system_rhs_fn)(const void *model, double speed_mps, const double *x, double *dxdt);
 typedef hm_status (*hm_system_jac_fn)(const void *model, double speed_mps, const double *x, double *jac);
+/* df/dv [per m/s] at x. */
+typedef hm_status (*hm_system_dfdv_fn)(const void *model, double speed_mps, const double *x, double *dfdv);
 
 typedef struct {
   size_t dim;                    /* state dimension, 1..HM_SYSTEM_MAX_DIM */
   hm_system_rhs_fn rhs;
   hm_system_jac_fn jacobian;
-  const void *model;             /* what rhs and jacobian read (kept by the caller while the system is used) */
+  hm_system_dfdv_fn dfdv;
+  const void *model;             /* what the callbacks read (kept by the caller while the system is used) */
   size_t n_bodies;               /* 1..HM_SYSTEM_MAX_BODIES */
   const char *const *body_names; /* n_bodies names */
   const int *state_body;         /* per state: its body (0..n_bodies-1), or -1 (a damper's internal state) */
   const double *state_inertia;   /* per state: the mass [kg] or inertia [kg m^2] of a velocity state, else 0 */
+  const double *state_scale;     /* per state: a typical size (1e-3 m, 0.1 m/s, ...): the cycles' Newton scales */
+  size_t amp_state;              /* the state whose max |x| is a cycle's amplitude (the leading wheelset's y) */
+  size_t phase_state;            /* its rate (x[amp_state]' = x[phase_state]): a cycle starts where it is 0 */
+  int odd;                       /* 1 if f(-x) = -f(x) (lambda(y) even): symmetric cycles, half-period shooting */
 } hm_system;
 
 /* The spectrum at one speed. */
@@ -72,7 +79,8 @@ typedef struct {
 void hm_system_critical_options_default(hm_system_critical_options *opt);
 
 /* Every field present and consistent (dim and n_bodies in range, callbacks set, bodies in range, inertias finite and
- * >= 0 and at least one > 0); HM_EINVAL otherwise. */
+ * >= 0 and at least one > 0, scales finite and > 0, amp_state and phase_state distinct states); HM_EINVAL
+ * otherwise. */
 hm_status hm_system_validate(const hm_system *sys);
 
 /* The spectrum of df/dx at x = 0 and speed_mps (> 0). out untouched on failure. */
@@ -84,10 +92,11 @@ hm_status hm_system_spectrum_at(const hm_system *sys, double speed_mps, hm_syste
 hm_status hm_system_critical_speed(const hm_system *sys, const hm_system_critical_options *opt, double *speed_mps,
                                    hm_system_spectrum *at_crit);
 
-/* docs/MODEL.md's wheelset as a system: one body ("wheelsets"), its mass and yaw inertia on states 1 and 3. */
+/* docs/MODEL.md's wheelset as a system: one body ("wheelsets"), its mass and yaw inertia on states 1 and 3; amplitude
+ * y (state 0), phase dy/dt (state 1), scales 1 mm, 0.1 m/s, 1 mrad, 0.1 rad/s. */
 typedef struct {
   hm_model model; /* the vehicle and its coefficients; the speed is given per call */
-  double inertia[4];
+  double inertia[4], scale[4];
   int body[4];
 } hm_wheelset_system;
 

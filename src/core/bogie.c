@@ -53,6 +53,23 @@ static hm_status sys_jac(const void *model, double v, const double *x, double *j
   return hm_bogie_jacobian((const hm_bogie_model *)model, v, x, jac);
 }
 
+static hm_status sys_dfdv(const void *model, double v, const double *x, double *dfdv) {
+  return hm_bogie_dfdv((const hm_bogie_model *)model, v, x, dfdv);
+}
+
+hm_status hm_bogie_dfdv(const hm_bogie_model *m, double v, const double *x, double *dfdv) {
+  const size_t n = m->frame_held ? HM_BOGIE_HELD_DIM : HM_BOGIE_DIM;
+  const double iv2 = 1.0 / (v * v);
+  for (size_t i = 0; i < n; ++i) dfdv[i] = 0.0;
+  for (int i = 0; i < 2; ++i) {
+    dfdv[4 * i + 1] = m->coef.c_lat_m_s2 * iv2 * x[4 * i + 1];
+    dfdv[4 * i + 3] = m->coef.c_yaw_m_s2 * iv2 * x[4 * i + 3];
+  }
+  for (size_t i = 0; i < n; ++i)
+    if (!isfinite(dfdv[i])) return HM_ENONFINITE;
+  return HM_OK;
+}
+
 hm_status hm_bogie_model_init(hm_bogie_model *m, const hm_bogie *bogie, int frame_held, hm_system *sys) {
   if (!m || !bogie || !sys) return HM_EINVAL;
   hm_status st = hm_bogie_validate(bogie, NULL, 0);
@@ -66,11 +83,14 @@ hm_status hm_bogie_model_init(hm_bogie_model *m, const hm_bogie *bogie, int fram
   const double inertia[HM_BOGIE_DIM] = {0, mw, 0, iw, 0, mw, 0, iw, 0, bogie->frame_mass_kg, 0,
                                         bogie->frame_yaw_inertia_kg_m2, 0};
   const int body[HM_BOGIE_DIM] = {0, 0, 0, 0, 0, 0, 0, 0, 1, 1, 1, 1, -1};
+  const double scale[HM_BOGIE_DIM] = {1e-3, 0.1, 1e-3, 0.1, 1e-3, 0.1, 1e-3, 0.1, 1e-3, 0.1, 1e-3, 0.1, 1e-3};
   memcpy(w.inertia, inertia, sizeof inertia);
+  memcpy(w.scale, scale, sizeof scale);
   memcpy(w.body, body, sizeof body);
   *m = w;
-  *sys = (hm_system){m->frame_held ? HM_BOGIE_HELD_DIM : HM_BOGIE_DIM, sys_rhs, sys_jac, m, 2, BOGIE_BODIES,
-                     m->body, m->inertia};
+  *sys = (hm_system){m->frame_held ? HM_BOGIE_HELD_DIM : HM_BOGIE_DIM, sys_rhs, sys_jac, sys_dfdv, m, 2,
+                     BOGIE_BODIES, m->body, m->inertia, m->scale, 0, 1,
+                     hm_conicity_is_even(&bogie->wheelset.conicity, 1e-12)};
   return HM_OK;
 }
 

@@ -8,8 +8,9 @@
 #include <stddef.h>
 
 #include "hunting_monitor/cycles.h"
+#include "hunting_monitor/system.h"
 
-#define HM_CONT_MAX_N 6 /* largest number of unknowns */
+#define HM_CONT_MAX_N (HM_SYSTEM_MAX_DIM + 2) /* largest number of unknowns: a cycle of any model (system_cycles.c) */
 
 /* The head of every problem's node: the unknowns and the unit tangent there. */
 typedef struct {

@@ -8,6 +8,7 @@
 #include "hunting_monitor/integrate.h"
 #include "hunting_monitor/linear.h"
 #include "continuation.h"
+#include "floquet.h"
 #include "shooting.h"
 
 const char *hm_cycle_event_name(hm_cycle_event_kind kind) {
@@ -37,8 +38,7 @@ void hm_cycle_options_default(hm_cycle_options *opt, hm_param p) {
 typedef struct {
   hm_cont_point head;    /* unknowns and unit tangent (scaled) */
   hm_cycle_point pub;
-  double bpc, pd;        /* test functions */
-  int ns_count;          /* complex non-trivial multipliers outside the unit circle */
+  hm_cycle_tests tests;  /* the event test functions (floquet.h) */
 } node;
 
 /* The continuation problem: the shooting equations in the unknowns u = (y0, psi0, dpsi0, T, p). */
@@ -54,58 +54,11 @@ typedef struct {
 } cyc;
 
 static hm_status fill_node(const hm_sh *c, const hm_shot *s, const double *u, const double *t, node *nd) {
-  double re[NX], im[NX];
-  hm_status st = hm_sh_eig4(s->phi, re, im);
-  if (st != HM_OK) return st;
-  /* Symmetric cycles: R = -Phi(T/2) has eigenvalues mu = -eig(Phi), the multipliers are mu^2, and
-   * det(R + I) = prod(mu + 1) changes sign where a real mu crosses -1 (symmetry-breaking branch point).
-   * Otherwise the multipliers are eig(Phi(T)) and the branch-point test is prod(m - 1) over the non-trivial
-   * real ones. The trivial multiplier (eigenvalue of R at +1 along the flow) is the one closest to +1. */
-  double bpc = 1.0;
-  int trivial = 0;
-  double dmin = INFINITY;
-  for (int i = 0; i < NX; ++i) {
-    const double mr = c->symmetric ? -re[i] : re[i], mi = c->symmetric ? -im[i] : im[i];
-    const double d = hypot(mr - 1.0, mi);
-    if (d < dmin) {
-      dmin = d;
-      trivial = i;
-    }
-    if (c->symmetric) {
-      if (mi == 0.0) bpc *= mr + 1.0;
-      re[i] = mr * mr - mi * mi;
-      im[i] = 2.0 * mr * mi;
-    }
-  }
-  if (!c->symmetric)
-    for (int i = 0; i < NX; ++i)
-      if (i != trivial && im[i] == 0.0) bpc *= re[i] - 1.0;
-  /* sort by decreasing modulus, following the trivial multiplier */
-  int order[NX] = {0, 1, 2, 3};
-  for (int i = 1; i < NX; ++i)
-    for (int j = i; j > 0 && hypot(re[order[j - 1]], im[order[j - 1]]) < hypot(re[order[j]], im[order[j]]); --j) {
-      const int tmp = order[j];
-      order[j] = order[j - 1];
-      order[j - 1] = tmp;
-    }
   node out;
   memset(&out, 0, sizeof out);
-  double pd = 1.0;
-  int n_unstable = 0, ns_count = 0;
-  for (int k = 0; k < NX; ++k) {
-    const int i = order[k];
-    out.pub.mult_re[k] = re[i];
-    out.pub.mult_im[k] = im[i];
-    if (i == trivial) {
-      out.pub.trivial_index = k;
-      continue;
-    }
-    const double mod = hypot(re[i], im[i]);
-    if (mod > 1.0) ++n_unstable;
-    if (fabs(im[i]) > 1e-12 * (1.0 + mod) && mod > 1.0) ++ns_count;
-    if (im[i] == 0.0) pd *= re[i] + 1.0;
-    else if (im[i] > 0.0) pd *= (re[i] + 1.0) * (re[i] + 1.0) + im[i] * im[i];
-  }
+  hm_status st = hm_floquet(NX, s->phi, c->symmetric, out.pub.mult_re, out.pub.mult_im, &out.pub.trivial_index,
+                            &out.pub.n_unstable, &out.tests);
+  if (st != HM_OK) return st;
   out.pub.param = u[4];
   out.pub.period_s = u[3];
   out.pub.amp_y_m = s->amp_y;
@@ -114,14 +67,11 @@ static hm_status fill_node(const hm_sh *c, const hm_shot *s, const double *u, co
   out.pub.x0[1] = 0.0;
   out.pub.x0[2] = u[1];
   out.pub.x0[3] = u[2];
-  out.pub.n_unstable = n_unstable;
-  out.pub.stable = n_unstable == 0;
+  out.pub.stable = out.pub.n_unstable == 0;
   out.pub.dparam_ds = t[4];
+  out.tests.dparam_ds = t[4];
   memcpy(out.head.t, t, NU * sizeof(double));
   memcpy(out.head.u, u, NU * sizeof(double));
-  out.bpc = bpc;
-  out.pd = pd;
-  out.ns_count = ns_count;
   *nd = out;
   return HM_OK;
 }
@@ -145,42 +95,22 @@ static hm_status cyc_finish(void *ctx, const double *u, const double *t, void *n
 
 /* ---- event location ---- */
 
-static double test_value(const node *nd, hm_cycle_event_kind kind) {
-  switch (kind) {
-    case HM_CYCLE_LPC: return nd->pub.dparam_ds;
-    case HM_CYCLE_BPC: return nd->bpc;
-    case HM_CYCLE_PD: return nd->pd;
-    case HM_CYCLE_NS: {
-      double worst = -INFINITY; /* largest modulus of a complex non-trivial multiplier, minus 1 */
-      for (int k = 0; k < NX; ++k)
-        if (k != nd->pub.trivial_index && nd->pub.mult_im[k] != 0.0)
-          worst = fmax(worst, hypot(nd->pub.mult_re[k], nd->pub.mult_im[k]) - 1.0);
-      return worst;
-    }
-  }
-  return NAN;
+static double test_fn(const void *nd, void *kind) {
+  return hm_cycle_test_value(&((const node *)nd)->tests, *(hm_cycle_event_kind *)kind);
 }
-
-static double test_fn(const void *nd, void *kind) { return test_value((const node *)nd, *(hm_cycle_event_kind *)kind); }
-
-static int sign_change(double x, double y) { return (x > 0.0) != (y > 0.0); }
 
 /* Detect and locate the events between consecutive nodes a and b (b reached from a with step ds). */
 static void detect_events(cyc *y, const node *a, const node *b, double ds) {
-  int flags[4] = {0, 0, 0, 0};
-  flags[HM_CYCLE_LPC] = sign_change(a->pub.dparam_ds, b->pub.dparam_ds);
-  flags[HM_CYCLE_BPC] = sign_change(a->bpc, b->bpc) && (y->sh.symmetric || !flags[HM_CYCLE_LPC]);
-  flags[HM_CYCLE_PD] = sign_change(a->pd, b->pd);
-  flags[HM_CYCLE_NS] = a->ns_count != b->ns_count && test_value(a, HM_CYCLE_NS) > -INFINITY &&
-                       test_value(b, HM_CYCLE_NS) > -INFINITY;
+  int flags[4];
+  hm_cycle_event_flags(&a->tests, &b->tests, y->sh.symmetric, flags);
   for (int k = 0; k < 4; ++k) {
     if (!flags[k]) continue;
     hm_cycle_event_kind kind = (hm_cycle_event_kind)k;
     node located;
-    if (hm_cont_locate(&y->prob, &y->opt->cont, a, b, ds, test_value(a, kind), test_value(b, kind), test_fn, &kind,
-                       &located) != HM_OK)
+    if (hm_cont_locate(&y->prob, &y->opt->cont, a, b, ds, hm_cycle_test_value(&a->tests, kind),
+                       hm_cycle_test_value(&b->tests, kind), test_fn, &kind, &located) != HM_OK)
       continue;
-    if (k == HM_CYCLE_NS && fabs(test_value(&located, HM_CYCLE_NS)) > 1e-4) continue; /* not a crossing */
+    if (k == HM_CYCLE_NS && fabs(located.tests.ns) > 1e-4) continue; /* not a crossing */
     hm_cycle_event ev;
     ev.kind = kind;
     ev.index = y->np;

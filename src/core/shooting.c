@@ -5,7 +5,6 @@
 #include <string.h>
 
 #include "hunting_monitor/linear.h"
-#include "lapack.h"
 
 const double hm_sh_res_scale[NX] = {1e-3, 1e-1, 1e-3, 1e-1};
 
@@ -84,7 +83,7 @@ static hm_status aug_rhs(double t, const double *z, double *dz, void *ctx) {
 /* The largest |q| over a step of a coordinate q whose velocity and acceleration are known at both ends (q = y with
  * y' = x2 and y'' = f2; q = psi likewise): at the ends, and where q' changes sign inside, at the root of q''s cubic
  * Hermite interpolant (bisection), with q from its quintic Hermite interpolant (error O(h^6)). */
-static double extreme(double h, double q0, double v0, double a0, double q1, double v1, double a1) {
+double hm_sh_extreme(double h, double q0, double v0, double a0, double q1, double v1, double a1) {
   double m = fmax(fabs(q0), fabs(q1));
   if ((v0 > 0.0) == (v1 > 0.0) || v0 == 0.0 || v1 == 0.0) return m;
   double lo = 0.0, hi = 1.0; /* s in [0, 1], t = t0 + s h */
@@ -109,8 +108,8 @@ static int amp_observer(double t_old, const double *x_old, const double *f_old, 
                         const double *f_new, void *ctx) {
   hm_sh *c = (hm_sh *)ctx;
   const double h = t_new - t_old;
-  c->amp_y = fmax(c->amp_y, extreme(h, x_old[0], x_old[1], f_old[1], x_new[0], x_new[1], f_new[1]));
-  c->amp_psi = fmax(c->amp_psi, extreme(h, x_old[2], x_old[3], f_old[3], x_new[2], x_new[3], f_new[3]));
+  c->amp_y = fmax(c->amp_y, hm_sh_extreme(h, x_old[0], x_old[1], f_old[1], x_new[0], x_new[1], f_new[1]));
+  c->amp_psi = fmax(c->amp_psi, hm_sh_extreme(h, x_old[2], x_old[3], f_old[3], x_new[2], x_new[3], f_new[3]));
   return 0;
 }
 
@@ -165,13 +164,3 @@ hm_status hm_sh_shoot(hm_sh *c, const double *u, hm_shot *s) {
   s->amp_psi = c->amp_psi;
   return HM_OK;
 }
-
-hm_status hm_sh_eig4(const double *colmajor, double *re, double *im) {
-  double a[NX * NX], work[128], dummy[1];
-  memcpy(a, colmajor, sizeof a);
-  const int n = NX, one = 1, lwork = 128;
-  int info = 0;
-  dgeev_("N", "N", &n, a, &n, re, im, dummy, &one, dummy, &one, work, &lwork, &info, 1, 1);
-  return info == 0 ? HM_OK : HM_ELAPACK;
-}
-

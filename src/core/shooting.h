@@ -47,7 +47,8 @@ void hm_sh_free(hm_sh *c);
 hm_status hm_sh_shoot(hm_sh *c, const double *u, hm_shot *s);
 /* Scale of an unknown in the continuation parameter's units. */
 double hm_sh_param_scale(hm_param p);
-/* Eigenvalues of a 4x4 column-major matrix (dgeev). */
-hm_status hm_sh_eig4(const double *colmajor, double *re, double *im);
+/* The largest |q| over a step of length h of a coordinate q whose value, rate and acceleration are known at both
+ * ends (quintic Hermite interpolation where the rate changes sign inside). Also system_cycles.c's. */
+double hm_sh_extreme(double h, double q0, double v0, double a0, double q1, double v1, double a1);
 
 #endif

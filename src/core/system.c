@@ -22,14 +22,17 @@ void hm_system_critical_options_default(hm_system_critical_options *opt) {
 }
 
 hm_status hm_system_validate(const hm_system *sys) {
-  if (!sys || !sys->rhs || !sys->jacobian || sys->dim < 1 || sys->dim > N_MAX || sys->n_bodies < 1 ||
-      sys->n_bodies > HM_SYSTEM_MAX_BODIES || !sys->body_names || !sys->state_body || !sys->state_inertia)
+  if (!sys || !sys->rhs || !sys->jacobian || !sys->dfdv || sys->dim < 2 || sys->dim > N_MAX || sys->n_bodies < 1 ||
+      sys->n_bodies > HM_SYSTEM_MAX_BODIES || !sys->body_names || !sys->state_body || !sys->state_inertia ||
+      !sys->state_scale || sys->amp_state >= sys->dim || sys->phase_state >= sys->dim ||
+      sys->amp_state == sys->phase_state)
     return HM_EINVAL;
   double total = 0.0;
   for (size_t i = 0; i < sys->dim; ++i) {
     const int b = sys->state_body[i];
-    const double w = sys->state_inertia[i];
+    const double w = sys->state_inertia[i], sc = sys->state_scale[i];
     if (b < -1 || b >= (int)sys->n_bodies || !isfinite(w) || w < 0.0 || (b < 0 && w > 0.0)) return HM_EINVAL;
+    if (!isfinite(sc) || !(sc > 0.0)) return HM_EINVAL;
     total += w;
   }
   return total > 0.0 ? HM_OK : HM_EINVAL;
@@ -171,15 +174,28 @@ static hm_status ws_jac(const void *model, double v, const double *x, double *ja
   return hm_model_jacobian_at(&((const hm_wheelset_system *)model)->model, v, x, jac);
 }
 
+static hm_status ws_dfdv(const void *model, double v, const double *x, double *dfdv) {
+  const hm_linear_coef *c = &((const hm_wheelset_system *)model)->model.coef;
+  const double iv2 = 1.0 / (v * v);
+  dfdv[0] = 0.0;
+  dfdv[1] = c->c_lat_m_s2 * iv2 * x[1];
+  dfdv[2] = 0.0;
+  dfdv[3] = c->c_yaw_m_s2 * iv2 * x[3];
+  return isfinite(dfdv[1]) && isfinite(dfdv[3]) ? HM_OK : HM_ENONFINITE;
+}
+
 hm_status hm_wheelset_system_init(hm_wheelset_system *ws, const hm_vehicle *veh, hm_system *sys) {
   if (!ws || !veh || !sys) return HM_EINVAL;
   hm_wheelset_system w;
   hm_status st = hm_model_init(&w.model, veh, 1.0);
   if (st != HM_OK) return st;
   const double inertia[4] = {0.0, veh->mass_kg, 0.0, veh->yaw_inertia_kg_m2};
+  const double scale[4] = {1e-3, 0.1, 1e-3, 0.1};
   memcpy(w.inertia, inertia, sizeof inertia);
+  memcpy(w.scale, scale, sizeof scale);
   for (int i = 0; i < 4; ++i) w.body[i] = 0;
   *ws = w;
-  *sys = (hm_system){4, ws_rhs, ws_jac, ws, 1, WHEELSET_BODIES, ws->body, ws->inertia};
+  *sys = (hm_system){4, ws_rhs, ws_jac, ws_dfdv, ws, 1, WHEELSET_BODIES, ws->body, ws->inertia, ws->scale, 0, 1,
+                     hm_conicity_is_even(&veh->conicity, 1e-12)};
   return HM_OK;
 }

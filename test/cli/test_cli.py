@@ -1034,6 +1034,31 @@ def test_bogie_critical_and_eig():
         assert p.returncode != 0 and "bogie.frame_mass_kg: must be > 0 (got -5)" in p.stderr, p.stderr
 
 
+def test_bogie_cycles():
+    """`hunting cycles` on config/bogie_default.yaml: born at the bogie's critical speed (as `critical` says), the
+    Floquet stability changing at each fold, CSV and JSON the same branch; options a bogie does not take refused."""
+    cfg = os.path.join(SRC, "config", "bogie_default.yaml")
+    crit = run_json("critical", "--config", cfg)
+    out = run_json("cycles", "--config", cfg, "--v-min", "450", "--v-max", "700", "--amp-max", "0.0065")
+    assert out["model"] == "bogie", out
+    close(out["hopf"]["v_kmh"], crit["v_crit_kmh"], 1e-6, "the family's Hopf speed")
+    close(out["branch"][0]["v_kmh"], crit["v_crit_kmh"], 0.05, "the first cycle at the Hopf speed")
+    close(out["branch"][0]["frequency_hz"], crit["frequency_hz"], 0.01, "the first cycle's frequency")
+    assert len(out["folds"]) >= 1, out["folds"]
+    br = out["branch"]
+    for f in out["folds"]:
+        k = f["index"]  # between points k - 1 and k: the stability flips there
+        assert br[k - 1]["stable"] != br[k]["stable"], (f, br[k - 1], br[k])
+        pair = (br[k - 1]["v_kmh"], br[k]["v_kmh"])  # a fold is the branch's extreme speed between them
+        assert f["v_kmh"] >= max(pair) - 1e-9 or f["v_kmh"] <= min(pair) + 1e-9, (f, pair)
+    csv_rows = run("cycles", "--config", cfg, "--v-min", "450", "--v-max", "700", "--amp-max", "0.0065",
+                   "--csv").stdout.strip().splitlines()
+    assert len(csv_rows) == len(br) + 1, (len(csv_rows), len(br))
+    close(float(csv_rows[-1].split(",")[1]), br[-1]["amplitude_m"], 1e-12, "the CSV's last amplitude")
+    p = run("cycles", "--config", cfg, "--param", "kx", ok=False)
+    assert p.returncode != 0 and "continued in speed only" in p.stderr, p.stderr
+
+
 def main():
     global failures
     tests = [(n, f) for n, f in globals().items() if n.startswith("test_") and callable(f)]

@@ -4,6 +4,7 @@
  * time simulation (classic RK4 of the right-hand side itself, no Jacobian, no LAPACK) on both sides of it. */
 #include <string.h>
 
+#include "bogie_rk4.h"
 #include "hm_test.h"
 #include "hunting_monitor/bogie.h"
 #include "hunting_monitor/linear.h"
@@ -93,20 +94,12 @@ static void jacobian_against_differences(void) {
 static double simulated_growth_rate(const hm_bogie_model *m, double v, double settle_s, double span_s) {
   const size_t n = HM_BOGIE_DIM;
   double x[HM_BOGIE_DIM] = {1e-8, 0.0, 2e-9, 0.0, -1e-8, 0.0, 1e-9, 0.0, 3e-9, 0.0, 1e-9, 0.0, 0.0};
-  double k1[HM_BOGIE_DIM], k2[HM_BOGIE_DIM], k3[HM_BOGIE_DIM], k4[HM_BOGIE_DIM], t[HM_BOGIE_DIM];
   const double h = 1e-3, block_s = 1.0;
   const long steps = (long)((settle_s + span_s) / h), per_block = (long)(block_s / h);
   double sx = 0.0, sy = 0.0, sxx = 0.0, sxy = 0.0, acc = 0.0, scale = 0.0;
   int nb = 0;
   for (long s = 1; s <= steps; ++s) {
-    hm_bogie_rhs(m, v, x, NULL, k1);
-    for (size_t i = 0; i < n; ++i) t[i] = x[i] + 0.5 * h * k1[i];
-    hm_bogie_rhs(m, v, t, NULL, k2);
-    for (size_t i = 0; i < n; ++i) t[i] = x[i] + 0.5 * h * k2[i];
-    hm_bogie_rhs(m, v, t, NULL, k3);
-    for (size_t i = 0; i < n; ++i) t[i] = x[i] + h * k3[i];
-    hm_bogie_rhs(m, v, t, NULL, k4);
-    for (size_t i = 0; i < n; ++i) x[i] += h / 6.0 * (k1[i] + 2.0 * k2[i] + 2.0 * k3[i] + k4[i]);
+    bogie_rk4_step(m, v, x, h);
     /* renormalise now and then (a growing or dying motion stays in range; the log keeps the total) */
     const double nx = fabs(x[0]) + fabs(x[4]) + fabs(x[8]);
     if (nx > 1e-6 || (nx < 1e-12 && nx > 0.0)) {
