@@ -81,6 +81,13 @@ hm_status hm_bogie_model_init(hm_bogie_model *m, const hm_bogie *bogie, int fram
 hm_status hm_bogie_rhs(const hm_bogie_model *m, double speed_mps, const double *x, const double *y_track_m,
                        double *dxdt);
 
+/* The same under a moving carbody (car.h): the secondary suspension acts on the frame's motion relative to the
+ * carbody's at the bogie centre, att = {lateral [m], its rate [m/s], yaw [rad], its rate [rad/s]} (the lateral spring
+ * and damper on yf - att[0] and yf' - att[1], the air springs and yaw dampers on psif - att[2]); also the secondary's
+ * force [N] and yaw moment [N m] on the carbody there. (hm_bogie_rhs: att = 0.) Not for a held frame. */
+hm_status hm_bogie_rhs_under(const hm_bogie_model *m, double speed_mps, const double *x, const double *y_track_m,
+                             const double att[4], double *dxdt, double *force_on_car_n, double *moment_on_car_nm);
+
 /* df/dv [per m/s] (the creep damping's 1/v terms). */
 hm_status hm_bogie_dfdv(const hm_bogie_model *m, double speed_mps, const double *x, double *dfdv);
 

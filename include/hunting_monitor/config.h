@@ -38,8 +38,12 @@
  *     yaw_damper_damping_n_s_m: 1e6          # each of two, in series with yaw_damper_stiffness_n_m,
  *     yaw_damper_stiffness_n_m: 5e7          # at lateral arm yaw_damper_half_distance_m
  *     yaw_damper_half_distance_m: 1.3
- * The wheelset's reader refuses a bogie config (and the bogie's a wheelset config): a model is never taken for
- * another silently.
+ * A whole vehicle (car.h; config/car_default.yaml): `model: car`, the sections above and
+ *   car:
+ *     carbody_mass_kg: 35000
+ *     carbody_yaw_inertia_kg_m2: 1.8e6
+ *     half_bogie_distance_m: 8.75
+ * Each reader refuses the other models' configs: a model is never taken for another silently.
  */
 #ifndef HUNTING_MONITOR_CONFIG_H
 #define HUNTING_MONITOR_CONFIG_H
@@ -47,6 +51,7 @@
 #include <stddef.h>
 
 #include "hunting_monitor/bogie.h"
+#include "hunting_monitor/car.h"
 #include "hunting_monitor/monitor.h"
 #include "hunting_monitor/model.h"
 #include "hunting_monitor/status.h"
@@ -80,6 +85,11 @@ hm_status hm_config_load_model_kind(const char *path, hm_model_kind *kind, char 
 hm_status hm_config_parse_bogie(const char *text, size_t len, const char *source, hm_bogie *bogie, char *name,
                                 char *err, size_t err_len);
 hm_status hm_config_load_bogie(const char *path, hm_bogie *bogie, char *name, char *err, size_t err_len);
+
+/* A car config (above): as hm_config_parse_bogie, then the car section, then hm_car_validate. */
+hm_status hm_config_parse_car(const char *text, size_t len, const char *source, hm_car *car, char *name, char *err,
+                              size_t err_len);
+hm_status hm_config_load_car(const char *path, hm_car *car, char *name, char *err, size_t err_len);
 
 /*
  * Monitor settings (config/monitor.yaml): optional sections `estimator:`, `modal:`, `margin:`, `alarm:` and `table:`

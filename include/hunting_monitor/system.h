@@ -29,10 +29,11 @@ extern "C" {
 /* The vehicle models the core holds (a vehicle config's `model:` key). */
 typedef enum {
   HM_MODEL_WHEELSET = 0, /* docs/MODEL.md's wheelset on fixed springs (model.h) */
-  HM_MODEL_BOGIE = 1     /* two such wheelsets on a bogie frame (bogie.h) */
+  HM_MODEL_BOGIE = 1,    /* two such wheelsets on a bogie frame (bogie.h) */
+  HM_MODEL_CAR = 2       /* a carbody on two such bogies (car.h) */
 } hm_model_kind;
 
-/* "wheelset", "bogie"; "unknown" otherwise. */
+/* "wheelset", "bogie", "car"; "unknown" otherwise. */
 const char *hm_model_kind_name(hm_model_kind kind);
 #define HM_SYSTEM_MAX_BODIES 4
 

@@ -170,15 +170,19 @@ int cli_model_kind(const cli_args *a, hm_model_kind *kind) {
   return 0;
 }
 
-int cli_bogie(const cli_args *a, hm_bogie *bogie, char *name) {
-  hm_bogie b;
+int cli_vehicle_model(const cli_args *a, hm_model_kind kind, cli_model *out) {
+  hm_car car;
   char err[512];
   const char *path = cli_value(a, "config");
-  if (!path || hm_config_load_bogie(path, &b, name, err, sizeof err) != HM_OK) {
-    fprintf(stderr, "hunting: config error: %s\n", path ? err : "a bogie needs --config FILE");
+  hm_car_default(&car);
+  hm_status st = !path ? HM_EINVAL
+                 : kind == HM_MODEL_CAR ? hm_config_load_car(path, &car, NULL, err, sizeof err)
+                                        : hm_config_load_bogie(path, &car.bogie, NULL, err, sizeof err);
+  if (st != HM_OK) {
+    fprintf(stderr, "hunting: config error: %s\n", path ? err : "a bogie or car needs --config FILE");
     return 1;
   }
-  hm_vehicle *w = &b.wheelset;
+  hm_vehicle *w = &car.bogie.wheelset;
   double kx = w->stiffness_long_n_m / 1e6, ky = w->stiffness_lat_n_m / 1e6, lambda0 = cli_conicity0(w);
   if (cli_number(a, "kx", &kx) || cli_number(a, "ky", &ky) || cli_number(a, "conicity", &lambda0)) return 1;
   w->stiffness_long_n_m = kx * 1e6;
@@ -187,11 +191,22 @@ int cli_bogie(const cli_args *a, hm_bogie *bogie, char *name) {
     fprintf(stderr, "hunting: --conicity %g: must be >= 0 and >= the Gaussian terms' value at y = 0\n", lambda0);
     return 1;
   }
-  if (hm_bogie_validate(&b, err, sizeof err) != HM_OK) {
-    fprintf(stderr, "hunting: invalid bogie: %s\n", err);
+  if (hm_car_validate(&car, err, sizeof err) != HM_OK) {
+    fprintf(stderr, "hunting: invalid %s: %s\n", hm_model_kind_name(kind), err);
     return 1;
   }
-  *bogie = b;
+  out->kind = kind;
+  out->wheelset = *w;
+  if (kind == HM_MODEL_CAR) {
+    st = hm_car_model_init(&out->car, &car, 0, &out->sys);
+    if (st == HM_OK) st = hm_car_model_init(&out->car_held, &car, 1, &out->held);
+    out->held_name = "carbody_held_v_crit_kmh";
+  } else {
+    st = hm_bogie_model_init(&out->bogie, &car.bogie, 0, &out->sys);
+    if (st == HM_OK) st = hm_bogie_model_init(&out->bogie_held, &car.bogie, 1, &out->held);
+    out->held_name = "frame_held_v_crit_kmh";
+  }
+  if (st != HM_OK) return cli_fail_status(hm_model_kind_name(kind), st);
   return 0;
 }
 

@@ -5,6 +5,7 @@
 #include <stdio.h>
 
 #include "hunting_monitor/bogie.h"
+#include "hunting_monitor/car.h"
 #include "hunting_monitor/model.h"
 #include "hunting_monitor/system.h"
 
@@ -43,8 +44,18 @@ int cli_vehicle(const cli_args *a, hm_vehicle *veh, char *name);
 double cli_conicity0(const hm_vehicle *veh);
 /* The model --config describes (none: the wheelset); 1 after printing the config's error. */
 int cli_model_kind(const cli_args *a, hm_model_kind *kind);
-/* The bogie of --config with --kx, --ky, --conicity applied to its wheelsets, validated; 1 after printing why not. */
-int cli_bogie(const cli_args *a, hm_bogie *bogie, char *name);
+/* A bogie or car of --config (kind) with --kx, --ky, --conicity applied to its wheelsets, validated, as a system and
+ * with its frame (bogie) or carbody (car) held; filled in place (its systems point into it: do not copy it). 1 after
+ * printing why not. */
+typedef struct {
+  hm_model_kind kind;
+  hm_vehicle wheelset;   /* the wheelsets' parameters (after the overrides) */
+  hm_bogie_model bogie, bogie_held;
+  hm_car_model car, car_held;
+  hm_system sys, held;
+  const char *held_name; /* the JSON key of the held variant's critical speed */
+} cli_model;
+int cli_vehicle_model(const cli_args *a, hm_model_kind kind, cli_model *out);
 
 void cli_print_help(FILE *f, const char *command, const char *usage, const char *summary, const cli_option *opts);
 

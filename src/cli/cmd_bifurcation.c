@@ -288,27 +288,27 @@ static int cycle_options(const cli_args *a, hm_param p, hm_cycle_options *o) {
 
 /* ---- cycles of a bogie (system_cycles.h) ---- */
 
-static double bogie_max_modulus(const hm_system_cycle_point *c) {
+static double system_max_modulus(const hm_system_cycle_point *c) {
   double m = 0.0;
   for (size_t k = 0; k < c->dim; ++k)
     if ((int)k != c->trivial_index) m = fmax(m, hypot(c->mult_re[k], c->mult_im[k]));
   return m;
 }
 
-static void write_bogie_cycle(json_writer *w, const hm_system_cycle_point *c) {
+static void write_system_cycle(json_writer *w, const hm_system_cycle_point *c) {
   jw_number(w, "v_kmh", c->speed_kmh);
   jw_number(w, "amplitude_m", c->amp_m);
   jw_number(w, "period_s", c->period_s);
   jw_number(w, "frequency_hz", 1.0 / c->period_s);
 }
 
-static void write_bogie_events(json_writer *w, const char *key, const hm_system_cycle_event *ev, size_t ne,
+static void write_system_events(json_writer *w, const char *key, const hm_system_cycle_event *ev, size_t ne,
                                hm_cycle_event_kind kind) {
   jw_array(w, key);
   for (size_t i = 0; i < ne; ++i) {
     if (ev[i].kind != kind) continue;
     jw_object(w, NULL);
-    write_bogie_cycle(w, &ev[i].point);
+    write_system_cycle(w, &ev[i].point);
     if (kind == HM_CYCLE_LPC)
       jw_string(w, "stable_side", ev[i].stable_side > 0 ? "upper" : ev[i].stable_side < 0 ? "lower" : "none");
     jw_int(w, "index", (long)ev[i].index);
@@ -317,13 +317,13 @@ static void write_bogie_events(json_writer *w, const char *key, const hm_system_
   jw_end_array(w);
 }
 
-static void write_bogie_family(FILE *f, const hm_system *sys, const hm_system_cycle_point *pts, size_t np,
+static void write_system_family(FILE *f, const hm_system *sys, const hm_system_cycle_point *pts, size_t np,
                                const hm_system_cycle_event *ev, size_t ne, const hm_cont_stats *st, int csv) {
   if (csv) {
     fprintf(f, "v_kmh,amplitude_m,period_s,stable,n_unstable,max_multiplier_modulus\n");
     for (size_t i = 0; i < np; ++i)
       fprintf(f, "%.10g,%.10g,%.10g,%d,%d,%.6g\n", pts[i].speed_kmh, pts[i].amp_m, pts[i].period_s, pts[i].stable,
-              pts[i].n_unstable, bogie_max_modulus(&pts[i]));
+              pts[i].n_unstable, system_max_modulus(&pts[i]));
     return;
   }
   hm_system_critical_options copt;
@@ -335,7 +335,7 @@ static void write_bogie_family(FILE *f, const hm_system *sys, const hm_system_cy
   json_writer w;
   jw_init(&w, f);
   jw_object(&w, NULL);
-  jw_string(&w, "model", "bogie");
+  jw_string(&w, "model", sys->n_bodies == 3 ? "car" : "bogie");
   jw_string(&w, "param", "v_kmh");
   jw_object(&w, "hopf");
   jw_number(&w, "v_kmh", have_hopf ? hm_kmh_from_mps(vh) : NAN);
@@ -343,20 +343,20 @@ static void write_bogie_family(FILE *f, const hm_system *sys, const hm_system_cy
   jw_string(&w, "mode", have_hopf ? sys->body_names[spec.dominant_body] : "");
   jw_string(&w, "kind", np > 1 ? (pts[1].speed_kmh < pts[0].speed_kmh ? "subcritical" : "supercritical") : "");
   jw_end_object(&w);
-  write_bogie_events(&w, "folds", ev, ne, HM_CYCLE_LPC);
-  write_bogie_events(&w, "branch_points", ev, ne, HM_CYCLE_BPC);
-  write_bogie_events(&w, "period_doublings", ev, ne, HM_CYCLE_PD);
-  write_bogie_events(&w, "neimark_sacker", ev, ne, HM_CYCLE_NS);
+  write_system_events(&w, "folds", ev, ne, HM_CYCLE_LPC);
+  write_system_events(&w, "branch_points", ev, ne, HM_CYCLE_BPC);
+  write_system_events(&w, "period_doublings", ev, ne, HM_CYCLE_PD);
+  write_system_events(&w, "neimark_sacker", ev, ne, HM_CYCLE_NS);
   jw_number(&w, "lowest_cycle_v_kmh", hm_system_cycles_lowest(pts, np, ev, ne));
   jw_string(&w, "stop_reason", hm_cont_stop_name(st->stop));
   write_cont_stats(&w, "continuation", st);
   jw_array(&w, "branch");
   for (size_t i = 0; i < np; ++i) {
     jw_object(&w, NULL);
-    write_bogie_cycle(&w, &pts[i]);
+    write_system_cycle(&w, &pts[i]);
     jw_bool(&w, "stable", pts[i].stable);
     jw_int(&w, "n_unstable", pts[i].n_unstable);
-    jw_number(&w, "max_multiplier_modulus", bogie_max_modulus(&pts[i]));
+    jw_number(&w, "max_multiplier_modulus", system_max_modulus(&pts[i]));
     jw_end_object(&w);
   }
   jw_end_array(&w);
@@ -364,15 +364,15 @@ static void write_bogie_family(FILE *f, const hm_system *sys, const hm_system_cy
   jw_finish(&w);
 }
 
-/* cycles on a bogie config: the family from its Hopf point in speed (system_cycles.h). */
-static int cycles_bogie(const cli_args *a) {
-  hm_bogie bogie;
-  if (cli_bogie(a, &bogie, NULL)) return 1;
+/* cycles on a bogie or car config: the family from its Hopf point in speed (system_cycles.h). */
+static int cycles_system(const cli_args *a, hm_model_kind kind) {
+  static cli_model cm; /* its systems point into it */
+  if (cli_vehicle_model(a, kind, &cm)) return 1;
   const char *pname = cli_value(a, "param");
   if ((pname && strcmp(pname, "v") && strcmp(pname, "v_kmh")) || cli_has(a, "refine") || cli_has(a, "from") ||
       cli_has(a, "to")) {
-    fprintf(stderr, "hunting cycles: a bogie's cycles are continued in speed only (no --param, --from, --to or "
-            "--refine yet)\n");
+    fprintf(stderr, "hunting cycles: a %s's cycles are continued in speed only (no --param, --from, --to or "
+            "--refine yet)\n", hm_model_kind_name(kind));
     return 1;
   }
   hm_system_cycle_options o;
@@ -388,20 +388,18 @@ static int cycles_bogie(const cli_args *a) {
             "1e-3\n", 2.0 * o.amp_start_m, o.cont.ds_init);
     return 1;
   }
-  hm_bogie_model m;
-  hm_system sys;
-  hm_status st = hm_bogie_model_init(&m, &bogie, 0, &sys);
-  if (st != HM_OK) return cli_fail_status("bogie", st);
+  const hm_system *sys = &cm.sys;
+  hm_status st;
   hm_system_cycle_point *pts = malloc(MAX_BRANCH * sizeof *pts);
   hm_system_cycle_event ev[MAX_EVENTS];
   size_t np = 0, ne = 0;
   hm_cont_stats cs;
   if (!pts) return cli_fail_status("cycles", HM_ENOMEM);
-  st = hm_system_cycles_continue(&sys, &o, pts, MAX_BRANCH, &np, ev, MAX_EVENTS, &ne, &cs);
+  st = hm_system_cycles_continue(sys, &o, pts, MAX_BRANCH, &np, ev, MAX_EVENTS, &ne, &cs);
   int rc = 0;
   if (st == HM_ENOCRIT) {
-    fprintf(stderr, "hunting cycles: the bogie has no Hopf point between %g and %g km/h\n", o.v_min_kmh,
-            o.v_max_kmh);
+    fprintf(stderr, "hunting cycles: the %s has no Hopf point between %g and %g km/h\n", hm_model_kind_name(kind),
+            o.v_min_kmh, o.v_max_kmh);
     rc = 1;
   } else if (st != HM_OK) {
     rc = cli_fail_status("cycles", st);
@@ -413,7 +411,7 @@ static int cycles_bogie(const cli_args *a) {
     rc = 1;
   }
   if (rc == 0) {
-    write_bogie_family(f, &sys, pts, np, ev, ne, &cs, cli_has(a, "csv"));
+    write_system_family(f, sys, pts, np, ev, ne, &cs, cli_has(a, "csv"));
     if (path && fclose(f) != 0) {
       perror(path);
       rc = 1;
@@ -430,7 +428,7 @@ int cmd_cycles(const cli_args *a) {
   hm_cycle_options o;
   hm_model_kind kind;
   if (cli_model_kind(a, &kind)) return 1;
-  if (kind == HM_MODEL_BOGIE) return cycles_bogie(a);
+  if (kind != HM_MODEL_WHEELSET) return cycles_system(a, kind);
   if (cli_vehicle(a, &veh, NULL) || param_option(a, &p) || fixed_speed(a, p, &speed) || cycle_options(a, p, &o))
     return 1;
   hm_hopf_point hopf;

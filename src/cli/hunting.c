@@ -39,8 +39,8 @@ int cli_speed_option(const cli_args *a, double *v_kmh) {
 
 static const cli_option critical_opts[] = {VEHICLE_OPTIONS, {NULL, NULL, NULL}};
 
-/* The bogie's spectrum at v (> 0) and the shares of its least-damped mode. */
-static void jw_bogie_mode(json_writer *w, const hm_system *sys, const hm_system_spectrum *s) {
+/* The least-damped mode of a spectrum: frequency, decay rate, whose it is and its kinetic energy by body. */
+static void jw_system_mode(json_writer *w, const hm_system *sys, const hm_system_spectrum *s) {
   jw_number(w, "frequency_hz", s->frequency_hz);
   jw_number(w, "decay_rate_1_s", s->abscissa_1_s);
   jw_string(w, "mode", sys->body_names[s->dominant_body]);
@@ -49,40 +49,35 @@ static void jw_bogie_mode(json_writer *w, const hm_system *sys, const hm_system_
   jw_end_object(w);
 }
 
-/* critical on a bogie: its linear critical speed by eigenvalues, the mode that goes first, and the lone wheelset's
- * (the frame held) beside it. */
-static int critical_bogie(const cli_args *a) {
-  hm_bogie bogie;
-  if (cli_bogie(a, &bogie, NULL)) return 1;
-  hm_bogie_model m, held;
-  hm_system sys, sys_held;
+/* critical on a bogie or car: its linear critical speed by eigenvalues, the mode that goes first, and the speed with
+ * its frame (bogie) or carbody (car) held beside it. */
+static int critical_system(const cli_args *a, hm_model_kind kind) {
+  static cli_model cm; /* its systems point into it */
+  if (cli_vehicle_model(a, kind, &cm)) return 1;
   hm_system_critical_options opt;
   hm_system_critical_options_default(&opt);
-  hm_status st = hm_bogie_model_init(&m, &bogie, 0, &sys);
-  if (st == HM_OK) st = hm_bogie_model_init(&held, &bogie, 1, &sys_held);
-  if (st != HM_OK) return fail_status("bogie", st);
   double v = 0.0, v_held = 0.0;
   hm_system_spectrum s;
-  st = hm_system_critical_speed(&sys, &opt, &v, &s);
-  const double lambda = cli_conicity0(&bogie.wheelset);
+  hm_status st = hm_system_critical_speed(&cm.sys, &opt, &v, &s);
+  const double lambda = cli_conicity0(&cm.wheelset);
   if (st == HM_ENOCRIT) {
-    fprintf(stderr, "hunting: no critical speed: the bogie at conicity %g is stable from 100 to 1500 km/h, or "
-            "unstable already at 100 km/h\n", lambda);
+    fprintf(stderr, "hunting: no critical speed: the %s at conicity %g is stable from 100 to 1500 km/h, or "
+            "unstable already at 100 km/h\n", hm_model_kind_name(kind), lambda);
     return 1;
   }
   if (st != HM_OK) return fail_status("critical speed", st);
-  const hm_status st_held = hm_system_critical_speed(&sys_held, &opt, &v_held, NULL);
+  const hm_status st_held = hm_system_critical_speed(&cm.held, &opt, &v_held, NULL);
   json_writer w;
   jw_init(&w, stdout);
   jw_object(&w, NULL);
-  jw_string(&w, "model", "bogie");
+  jw_string(&w, "model", hm_model_kind_name(kind));
   jw_number(&w, "v_crit_kmh", hm_kmh_from_mps(v));
   jw_number(&w, "v_crit_mps", v);
-  jw_bogie_mode(&w, &sys, &s);
+  jw_system_mode(&w, &cm.sys, &s);
   jw_number(&w, "conicity", lambda);
-  jw_number(&w, "kx_mn_m", bogie.wheelset.stiffness_long_n_m / 1e6);
-  jw_number(&w, "ky_mn_m", bogie.wheelset.stiffness_lat_n_m / 1e6);
-  jw_number(&w, "frame_held_v_crit_kmh", st_held == HM_OK ? hm_kmh_from_mps(v_held) : NAN);
+  jw_number(&w, "kx_mn_m", cm.wheelset.stiffness_long_n_m / 1e6);
+  jw_number(&w, "ky_mn_m", cm.wheelset.stiffness_lat_n_m / 1e6);
+  jw_number(&w, cm.held_name, st_held == HM_OK ? hm_kmh_from_mps(v_held) : NAN);
   jw_spectrum(&w, "eigenvalues", &s);
   jw_end_object(&w);
   jw_finish(&w);
@@ -93,7 +88,7 @@ static int cmd_critical(const cli_args *a) {
   hm_vehicle veh;
   hm_model_kind kind;
   if (cli_model_kind(a, &kind)) return 1;
-  if (kind == HM_MODEL_BOGIE) return critical_bogie(a);
+  if (kind != HM_MODEL_WHEELSET) return critical_system(a, kind);
   if (cli_vehicle(a, &veh, NULL)) return 1;
   const double lambda = cli_conicity0(&veh);
   double v_mps, omega, re[4], im[4];
@@ -155,26 +150,23 @@ static int cmd_critical_conicity(const cli_args *a) {
 
 static const cli_option eig_opts[] = {{"v", "KM/H", "running speed (required)"}, VEHICLE_OPTIONS, {NULL, NULL, NULL}};
 
-static int eig_bogie(const cli_args *a) {
-  hm_bogie bogie;
+static int eig_system(const cli_args *a, hm_model_kind kind) {
+  static cli_model cm;
   double v_kmh;
-  if (cli_bogie(a, &bogie, NULL) || cli_speed_option(a, &v_kmh)) return 1;
-  hm_bogie_model m;
-  hm_system sys;
+  if (cli_vehicle_model(a, kind, &cm) || cli_speed_option(a, &v_kmh)) return 1;
   hm_system_spectrum s;
-  hm_status st = hm_bogie_model_init(&m, &bogie, 0, &sys);
-  if (st == HM_OK) st = hm_system_spectrum_at(&sys, hm_mps_from_kmh(v_kmh), &s);
+  hm_status st = hm_system_spectrum_at(&cm.sys, hm_mps_from_kmh(v_kmh), &s);
   if (st != HM_OK) return fail_status("eigenvalues", st);
   json_writer w;
   jw_init(&w, stdout);
   jw_object(&w, NULL);
-  jw_string(&w, "model", "bogie");
+  jw_string(&w, "model", hm_model_kind_name(kind));
   jw_number(&w, "v_kmh", v_kmh);
-  jw_number(&w, "conicity", cli_conicity0(&bogie.wheelset));
+  jw_number(&w, "conicity", cli_conicity0(&cm.wheelset));
   jw_spectrum(&w, "eigenvalues", &s);
   jw_bool(&w, "stable", s.re[0] < 0.0);
   jw_object(&w, "least_damped");
-  jw_bogie_mode(&w, &sys, &s);
+  jw_system_mode(&w, &cm.sys, &s);
   jw_end_object(&w);
   jw_end_object(&w);
   jw_finish(&w);
@@ -186,7 +178,7 @@ static int cmd_eig(const cli_args *a) {
   double v_kmh, re[4], im[4];
   hm_model_kind kind;
   if (cli_model_kind(a, &kind)) return 1;
-  if (kind == HM_MODEL_BOGIE) return eig_bogie(a);
+  if (kind != HM_MODEL_WHEELSET) return eig_system(a, kind);
   if (cli_vehicle(a, &veh, NULL) || cli_speed_option(a, &v_kmh)) return 1;
   const double lambda = cli_conicity0(&veh);
   hm_status st = hm_linear_eigenvalues(&veh, lambda, hm_mps_from_kmh(v_kmh), re, im);
@@ -511,17 +503,19 @@ static const command commands[] = {
     {"critical", "linear critical (Hopf) speed, hunting frequency, eigenvalues there", "[options]",
      "Linear critical (Hopf) speed from the closed-form Hurwitz condition, the hunting frequency there, and the\n"
      "eigenvalues at that speed (LAPACK dgeev). JSON: model, v_crit_kmh, frequency_hz, eigenvalues [[re, im], ...].\n"
-     "A bogie's config (model: bogie, config/bogie_default.yaml): the speed where the largest real part of its\n"
-     "13 eigenvalues reaches 0 (a 5 km/h scan from 100 km/h, bisection to 1e-9 km/h), that mode's frequency and\n"
-     "whose it is (mode: wheelsets or bogie frame, mode_energy_share: its kinetic energy by body), and\n"
-     "frame_held_v_crit_kmh: the lone wheelset's (the frame held at rest).",
+     "A bogie's or car's config (model: bogie | car, config/bogie_default.yaml, car_default.yaml): the speed where\n"
+     "the largest real part of its 13 (30) eigenvalues reaches 0 (a 5 km/h scan from 100 km/h, bisection to 1e-9\n"
+     "km/h), that mode's frequency and whose it is (mode: wheelsets, bogie frame or carbody; mode_energy_share: its\n"
+     "kinetic energy by body), and frame_held_v_crit_kmh (the lone wheelset's) or carbody_held_v_crit_kmh (the\n"
+     "bogie's).",
      critical_opts, cmd_critical},
     {"critical-conicity", "critical equivalent conicity at a speed", "--v KM/H [options]",
      "Largest equivalent conicity for which the linear model is stable at the given speed (closed form).",
      critical_conicity_opts, cmd_critical_conicity},
     {"eig", "eigenvalues of the linearised model and stability", "--v KM/H [options]",
-     "Eigenvalues [1/s] of the linearised model at the origin and whether it is stable. With a bogie's config also\n"
-     "its least-damped mode: frequency, decay rate and whose it is (wheelsets or bogie frame).", eig_opts, cmd_eig},
+     "Eigenvalues [1/s] of the linearised model at the origin and whether it is stable. With a bogie's or car's\n"
+     "config also its least-damped mode: frequency, decay rate and whose it is (wheelsets, bogie frame, carbody).",
+     eig_opts, cmd_eig},
     {"simulate", "time integration of the nonlinear model to CSV", "--v KM/H [--x0 Y,DY,PSI,DPSI] [--t SECONDS] [options]",
      "Integrate the nonlinear model (Dormand-Prince 5(4), error control, dense output) and write CSV:\n"
      "t_s,y_m,dy_mps,psi_rad,dpsi_radps,accel_lat_mps2 (the lateral acceleration is dy'/dt of the model);\n"

@@ -95,6 +95,13 @@ hm_status hm_bogie_model_init(hm_bogie_model *m, const hm_bogie *bogie, int fram
 }
 
 hm_status hm_bogie_rhs(const hm_bogie_model *m, double v, const double *x, const double *y_track_m, double *dxdt) {
+  static const double at_rest[4] = {0.0, 0.0, 0.0, 0.0};
+  double f, mz;
+  return hm_bogie_rhs_under(m, v, x, y_track_m, at_rest, dxdt, &f, &mz);
+}
+
+hm_status hm_bogie_rhs_under(const hm_bogie_model *m, double v, const double *x, const double *y_track_m,
+                             const double att[4], double *dxdt, double *force_on_car_n, double *moment_on_car_nm) {
   const hm_bogie *b = &m->bogie;
   const hm_linear_coef *c = &m->coef;
   const double mw = b->wheelset.mass_kg, ky_s2 = b->wheelset.stiffness_lat_n_m / mw;
@@ -121,21 +128,27 @@ hm_status hm_bogie_rhs(const hm_bogie_model *m, double v, const double *x, const
     mz += xs[i] * ky * q + kyaw * (w[2] - psif);
   }
   size_t n = HM_BOGIE_HELD_DIM;
+  double f_car = 0.0, m_car = 0.0;
   if (!m->frame_held) {
     const double dd = b->yaw_damper_half_distance_m, kd = b->yaw_damper_stiffness_n_m;
-    const double damper = kd * (dd * psif - x[12]); /* the force in each yaw damper */
+    const double rel_psi = psif - att[2];
+    const double damper = kd * (dd * rel_psi - x[12]); /* the force in each yaw damper */
     const double ka_yaw = 2.0 * b->airspring_long_stiffness_n_m * b->airspring_half_distance_m *
                           b->airspring_half_distance_m;
+    f_car = b->secondary_lat_stiffness_n_m * (yf - att[0]) + b->secondary_lat_damping_n_s_m * (x[9] - att[1]);
+    m_car = ka_yaw * rel_psi + 2.0 * dd * damper;
     dx[8] = x[9];
-    dx[9] = (fy - b->secondary_lat_stiffness_n_m * yf - b->secondary_lat_damping_n_s_m * x[9]) / b->frame_mass_kg;
+    dx[9] = (fy - f_car) / b->frame_mass_kg;
     dx[10] = x[11];
-    dx[11] = (mz - ka_yaw * psif - 2.0 * dd * damper) / b->frame_yaw_inertia_kg_m2;
+    dx[11] = (mz - m_car) / b->frame_yaw_inertia_kg_m2;
     dx[12] = damper / b->yaw_damper_damping_n_s_m;
     n = HM_BOGIE_DIM;
   }
   for (size_t i = 0; i < n; ++i)
     if (!isfinite(dx[i])) return HM_ENONFINITE;
   memcpy(dxdt, dx, n * sizeof(double));
+  *force_on_car_n = f_car;
+  *moment_on_car_nm = m_car;
   return HM_OK;
 }
 

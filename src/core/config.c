@@ -214,7 +214,11 @@ static hm_status parse_model_kind(parse_ctx *c, yaml_node_t *root, hm_model_kind
     *kind = HM_MODEL_BOGIE;
     return HM_OK;
   }
-  return fail(c, n, HM_EPARSE, "model: expected wheelset or bogie, got '%s'",
+  if (n->type == YAML_SCALAR_NODE && strcmp(scalar_text(n), "car") == 0) {
+    *kind = HM_MODEL_CAR;
+    return HM_OK;
+  }
+  return fail(c, n, HM_EPARSE, "model: expected wheelset, bogie or car, got '%s'",
               n->type == YAML_SCALAR_NODE ? scalar_text(n) : "(not a name)");
 }
 
@@ -307,6 +311,19 @@ static hm_status read_small_file(parse_ctx *c, const char *path, char **text, si
 
 /* ---- the bogie (bogie.h) ---- */
 
+/* Every key of the section one of fields (all required), SI numbers into base + offset. */
+static hm_status parse_number_section(parse_ctx *c, yaml_node_t *sec, const char *name, const number_field *fields,
+                                      size_t n, void *base) {
+  const char *allowed[16];
+  if (n >= 16) return fail(c, sec, HM_EINVAL, "%s: too many fields", name);
+  for (size_t i = 0; i < n; ++i) allowed[i] = fields[i].key;
+  allowed[n] = NULL;
+  hm_status st = check_keys(c, sec, name, allowed);
+  for (size_t i = 0; st == HM_OK && i < n; ++i)
+    st = get_number(c, sec, name, fields[i].key, (double *)((char *)base + fields[i].offset));
+  return st;
+}
+
 static hm_status parse_bogie_section(parse_ctx *c, yaml_node_t *sec, hm_bogie *b) {
 #define BF(f) {#f, 0, offsetof(hm_bogie, f)}
   static const number_field fields[] = {
@@ -322,14 +339,16 @@ static hm_status parse_bogie_section(parse_ctx *c, yaml_node_t *sec, hm_bogie *b
       BF(yaw_damper_half_distance_m),
   };
 #undef BF
-  enum { N_FIELDS = sizeof fields / sizeof fields[0] };
-  const char *allowed[N_FIELDS + 1];
-  for (size_t i = 0; i < N_FIELDS; ++i) allowed[i] = fields[i].key;
-  allowed[N_FIELDS] = NULL;
-  hm_status st = check_keys(c, sec, "bogie", allowed);
-  for (size_t i = 0; st == HM_OK && i < N_FIELDS; ++i)
-    st = get_number(c, sec, "bogie", fields[i].key, (double *)((char *)b + fields[i].offset));
-  return st;
+  return parse_number_section(c, sec, "bogie", fields, sizeof fields / sizeof fields[0], b);
+}
+
+static hm_status parse_car_section(parse_ctx *c, yaml_node_t *sec, hm_car *car) {
+  static const number_field fields[] = {
+      {"carbody_mass_kg", 0, offsetof(hm_car, carbody_mass_kg)},
+      {"carbody_yaw_inertia_kg_m2", 0, offsetof(hm_car, carbody_yaw_inertia_kg_m2)},
+      {"half_bogie_distance_m", 0, offsetof(hm_car, half_bogie_distance_m)},
+  };
+  return parse_number_section(c, sec, "car", fields, sizeof fields / sizeof fields[0], car);
 }
 
 hm_status hm_config_model_kind(const char *text, size_t len, const char *source, hm_model_kind *kind, char *err,
@@ -349,28 +368,53 @@ hm_status hm_config_model_kind(const char *text, size_t len, const char *source,
   return st;
 }
 
+/* The wheelset's and the bogie's sections of a `want` (bogie or car) config into *bogie, the car's into *car. */
+static hm_status parse_vehicle_model(const char *text, size_t len, const char *source, hm_model_kind want,
+                                     hm_bogie *bogie, hm_car *car, char *name, char *err, size_t err_len) {
+  parse_ctx c = {NULL, source ? source : "<config>", err, err_len};
+  yaml_document_t doc;
+  hm_status st = load_document(&c, text, len, &doc);
+  if (st != HM_OK) return st;
+  yaml_node_t *sb = NULL, *sc = NULL;
+  st = parse_document(&c, want, &bogie->wheelset, name);
+  if (st == HM_OK) st = get_section(&c, yaml_document_get_root_node(&doc), "bogie", &sb);
+  if (st == HM_OK) st = parse_bogie_section(&c, sb, bogie);
+  if (st == HM_OK && car) st = get_section(&c, yaml_document_get_root_node(&doc), "car", &sc);
+  if (st == HM_OK && car) st = parse_car_section(&c, sc, car);
+  if (st == HM_OK) {
+    char why[160];
+    if (car) car->bogie = *bogie;
+    st = car ? hm_car_validate(car, why, sizeof why) : hm_bogie_validate(bogie, why, sizeof why);
+    if (st != HM_OK) fail(&c, NULL, st, "%s", why);
+  }
+  yaml_document_delete(&doc);
+  return st;
+}
+
 hm_status hm_config_parse_bogie(const char *text, size_t len, const char *source, hm_bogie *bogie, char *name,
                                 char *err, size_t err_len) {
   parse_ctx c = {NULL, source ? source : "<config>", err, err_len};
   if (!text || !bogie) return fail(&c, NULL, HM_EINVAL, "no text or no output");
-  yaml_document_t doc;
-  hm_status st = load_document(&c, text, len, &doc);
-  if (st != HM_OK) return st;
   hm_bogie out;
   hm_bogie_default(&out);
   char out_name[HM_VEHICLE_NAME_MAX];
-  yaml_node_t *sb = NULL;
-  st = parse_document(&c, HM_MODEL_BOGIE, &out.wheelset, out_name);
-  if (st == HM_OK) st = get_section(&c, yaml_document_get_root_node(&doc), "bogie", &sb);
-  if (st == HM_OK) st = parse_bogie_section(&c, sb, &out);
-  if (st == HM_OK) {
-    char why[160];
-    st = hm_bogie_validate(&out, why, sizeof why);
-    if (st != HM_OK) fail(&c, NULL, st, "%s", why);
-  }
-  yaml_document_delete(&doc);
+  hm_status st = parse_vehicle_model(text, len, source, HM_MODEL_BOGIE, &out, NULL, out_name, err, err_len);
   if (st != HM_OK) return st;
   *bogie = out;
+  if (name) memcpy(name, out_name, HM_VEHICLE_NAME_MAX);
+  return HM_OK;
+}
+
+hm_status hm_config_parse_car(const char *text, size_t len, const char *source, hm_car *car, char *name, char *err,
+                              size_t err_len) {
+  parse_ctx c = {NULL, source ? source : "<config>", err, err_len};
+  if (!text || !car) return fail(&c, NULL, HM_EINVAL, "no text or no output");
+  hm_car out;
+  hm_car_default(&out);
+  char out_name[HM_VEHICLE_NAME_MAX];
+  hm_status st = parse_vehicle_model(text, len, source, HM_MODEL_CAR, &out.bogie, &out, out_name, err, err_len);
+  if (st != HM_OK) return st;
+  *car = out;
   if (name) memcpy(name, out_name, HM_VEHICLE_NAME_MAX);
   return HM_OK;
 }
@@ -406,6 +450,14 @@ static hm_status read_vehicle(const char *t, size_t n, const char *src, void *ou
 
 hm_status hm_config_load_vehicle(const char *path, hm_vehicle *veh, char *name, char *err, size_t err_len) {
   return load_with(path, read_vehicle, veh, name, err, err_len);
+}
+
+static hm_status read_car(const char *t, size_t n, const char *src, void *out, char *name, char *e, size_t el) {
+  return hm_config_parse_car(t, n, src, (hm_car *)out, name, e, el);
+}
+
+hm_status hm_config_load_car(const char *path, hm_car *car, char *name, char *err, size_t err_len) {
+  return load_with(path, read_car, car, name, err, err_len);
 }
 
 hm_status hm_config_load_model_kind(const char *path, hm_model_kind *kind, char *err, size_t err_len) {

@@ -11,7 +11,8 @@
 enum { N_MAX = HM_SYSTEM_MAX_DIM, LWORK = 8 * HM_SYSTEM_MAX_DIM };
 
 const char *hm_model_kind_name(hm_model_kind kind) {
-  return kind == HM_MODEL_WHEELSET ? "wheelset" : kind == HM_MODEL_BOGIE ? "bogie" : "unknown";
+  return kind == HM_MODEL_WHEELSET ? "wheelset" : kind == HM_MODEL_BOGIE ? "bogie" : kind == HM_MODEL_CAR ? "car"
+                                                                                                    : "unknown";
 }
 
 void hm_system_critical_options_default(hm_system_critical_options *opt) {

@@ -1059,6 +1059,23 @@ def test_bogie_cycles():
     assert p.returncode != 0 and "continued in speed only" in p.stderr, p.stderr
 
 
+def test_car_critical_and_cycles():
+    """The whole vehicle (config/car_default.yaml): with its carbody held its critical speed is the bogie's; the
+    origin's stability flips within 0.01 km/h of its own (eig); its family starts there."""
+    car = os.path.join(SRC, "config", "car_default.yaml")
+    bogie = os.path.join(SRC, "config", "bogie_default.yaml")
+    out = run_json("critical", "--config", car)
+    assert out["model"] == "car" and len(out["eigenvalues"]) == 30, out["model"]
+    close(out["carbody_held_v_crit_kmh"], run_json("critical", "--config", bogie)["v_crit_kmh"], 1e-6,
+          "the held carbody's critical speed against the bogie's")
+    below = run_json("eig", "--config", car, "--v", str(out["v_crit_kmh"] - 0.01))
+    above = run_json("eig", "--config", car, "--v", str(out["v_crit_kmh"] + 0.01))
+    assert below["stable"] is True and above["stable"] is False, (below["least_damped"], above["least_damped"])
+    fam = run_json("cycles", "--config", car, "--v-min", "450", "--v-max", "700", "--amp-max", "0.004")
+    assert fam["model"] == "car", fam["model"]
+    close(fam["hopf"]["v_kmh"], out["v_crit_kmh"], 1e-6, "the car family's Hopf speed")
+
+
 def main():
     global failures
     tests = [(n, f) for n, f in globals().items() if n.startswith("test_") and callable(f)]

@@ -15,6 +15,10 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size) {
   const hm_status bst = hm_config_parse_bogie((const char *)data, size, "fuzz", &bogie, name, err, sizeof err);
   if (bst == HM_OK && (hm_bogie_validate(&bogie, NULL, 0) != HM_OK || kst != HM_OK || kind != HM_MODEL_BOGIE))
     __builtin_trap(); /* parsed means valid, and a bogie */
+  hm_car car;
+  if (hm_config_parse_car((const char *)data, size, "fuzz", &car, name, err, sizeof err) == HM_OK &&
+      (hm_car_validate(&car, NULL, 0) != HM_OK || kst != HM_OK || kind != HM_MODEL_CAR))
+    __builtin_trap();
   if (hm_config_parse_vehicle((const char *)data, size, "fuzz", &v, name, err, sizeof err) != HM_OK) return 0;
   if (hm_vehicle_validate(&v, NULL, 0) != HM_OK) __builtin_trap(); /* parsed means valid */
   size_t need = 0;

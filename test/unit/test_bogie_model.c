@@ -4,8 +4,8 @@
  * time simulation (classic RK4 of the right-hand side itself, no Jacobian, no LAPACK) on both sides of it. */
 #include <string.h>
 
-#include "bogie_rk4.h"
 #include "hm_test.h"
+#include "system_checks.h"
 #include "hunting_monitor/bogie.h"
 #include "hunting_monitor/linear.h"
 
@@ -62,62 +62,14 @@ static void held_frame_is_the_lone_wheelset(void) {
 static void jacobian_against_differences(void) {
   hm_bogie b;
   hm_bogie_default(&b);
+  const double x[HM_BOGIE_DIM] = {0.0062, 0.05, 0.0011, -0.02, -0.0048, 0.03, -0.0007, 0.01,
+                                  0.0015, -0.004, 0.0003, 0.002, 0.0002};
   for (int held = 0; held <= 1; ++held) {
     hm_bogie_model m;
     hm_system sys;
     HM_CHECK(hm_bogie_model_init(&m, &b, held, &sys) == HM_OK, "init");
-    const size_t n = sys.dim;
-    double x[HM_BOGIE_DIM] = {0.0062, 0.05, 0.0011, -0.02, -0.0048, 0.03, -0.0007, 0.01,
-                              0.0015, -0.004, 0.0003, 0.002, 0.0002};
-    double jac[HM_BOGIE_DIM * HM_BOGIE_DIM], fp[HM_BOGIE_DIM], fm[HM_BOGIE_DIM];
-    const double v = hm_mps_from_kmh(380.0);
-    HM_CHECK(hm_bogie_jacobian(&m, v, x, jac) == HM_OK, "jacobian");
-    for (size_t j = 0; j < n; ++j) {
-      const double h = 1e-7 * fmax(1e-3, fabs(x[j])), xj = x[j];
-      x[j] = xj + h;
-      hm_bogie_rhs(&m, v, x, NULL, fp);
-      x[j] = xj - h;
-      hm_bogie_rhs(&m, v, x, NULL, fm);
-      x[j] = xj;
-      for (size_t i = 0; i < n; ++i) {
-        const double fd = (fp[i] - fm[i]) / (2.0 * h);
-        HM_CHECK(fabs(jac[n * i + j] - fd) <= 1e-6 * fabs(fd) + 1e-3,
-                 "held %d: d f%zu / d x%zu = %.9g, differences %.9g", held, i, j, jac[n * i + j], fd);
-      }
-    }
+    check_jacobian(&sys, hm_mps_from_kmh(380.0), x, held ? "frame held" : "frame free");
   }
-}
-
-/* Growth rate of the linearised motion from the simulation: RK4 of hm_bogie_rhs at 1 ms from a 1e-8 m disturbance
- * (far inside the linear range), a settling time for the other modes to die out, then the least-squares slope of
- * ln |x|^2 over the rest, averaged over whole periods by fitting at the peaks' envelope (a period's mean). */
-static double simulated_growth_rate(const hm_bogie_model *m, double v, double settle_s, double span_s) {
-  const size_t n = HM_BOGIE_DIM;
-  double x[HM_BOGIE_DIM] = {1e-8, 0.0, 2e-9, 0.0, -1e-8, 0.0, 1e-9, 0.0, 3e-9, 0.0, 1e-9, 0.0, 0.0};
-  const double h = 1e-3, block_s = 1.0;
-  const long steps = (long)((settle_s + span_s) / h), per_block = (long)(block_s / h);
-  double sx = 0.0, sy = 0.0, sxx = 0.0, sxy = 0.0, acc = 0.0, scale = 0.0;
-  int nb = 0;
-  for (long s = 1; s <= steps; ++s) {
-    bogie_rk4_step(m, v, x, h);
-    /* renormalise now and then (a growing or dying motion stays in range; the log keeps the total) */
-    const double nx = fabs(x[0]) + fabs(x[4]) + fabs(x[8]);
-    if (nx > 1e-6 || (nx < 1e-12 && nx > 0.0)) {
-      for (size_t i = 0; i < n; ++i) x[i] /= nx / 1e-8;
-      scale += log(nx / 1e-8);
-    }
-    if (s * h > settle_s) {
-      acc += x[0] * x[0] + x[4] * x[4];
-      if (s % per_block == 0) {
-        const double tc = (s - per_block / 2) * h, y = log(acc / per_block) + 2.0 * scale;
-        sx += tc, sy += y, sxx += tc * tc, sxy += tc * y;
-        ++nb;
-        acc = 0.0;
-      }
-    }
-  }
-  const double slope = (nb * sxy - sx * sy) / (nb * sxx - sx * sx);
-  return 0.5 * slope; /* |x|^2 grows at twice the rate */
 }
 
 /* The critical speed by eigenvalues against the simulation: stable 0.1 km/h below it, unstable 0.1 km/h above it,
@@ -137,15 +89,15 @@ static void critical_speed_against_simulation(void) {
     HM_CHECK(hm_system_critical_speed(&sys, &opt, &vc, &s) == HM_OK, "critical");
     printf("  conicity %.4f: critical %.4f km/h at %.3f Hz, the mode's energy %.2f in the wheelsets, %.2f in the "
            "frame\n", lambdas[k], hm_kmh_from_mps(vc), s.frequency_hz, s.body_share[0], s.body_share[1]);
-    const double below = simulated_growth_rate(&m, vc - hm_mps_from_kmh(0.1), 60.0, 240.0);
-    const double above = simulated_growth_rate(&m, vc + hm_mps_from_kmh(0.1), 60.0, 240.0);
+    const double below = system_growth_rate(&sys, vc - hm_mps_from_kmh(0.1), 60.0, 240.0);
+    const double above = system_growth_rate(&sys, vc + hm_mps_from_kmh(0.1), 60.0, 240.0);
     printf("  simulated growth rates 0.1 km/h below and above: %.5f, %.5f 1/s\n", below, above);
     HM_CHECK(below < 0.0 && above > 0.0, "the simulation's stability changes within 0.1 km/h of the critical speed");
     for (int side = -1; side <= 1; side += 2) {
       const double v = vc + side * hm_mps_from_kmh(15.0);
       hm_system_spectrum e;
       HM_CHECK(hm_system_spectrum_at(&sys, v, &e) == HM_OK, "spectrum");
-      const double g = simulated_growth_rate(&m, v, 60.0, 60.0);
+      const double g = system_growth_rate(&sys, v, 60.0, 60.0);
       HM_CHECK_DELTA(g, e.abscissa_1_s, 0.03 * fabs(e.abscissa_1_s), "growth rate 15 km/h off the critical speed");
     }
   }

@@ -232,8 +232,9 @@ static void monitor_settings(void) {
   }
 }
 
-/* The bogie (issue #28): the shipped config/bogie_default.yaml holds hm_bogie_default's values; the two readers
- * refuse each other's configs; the bogie section's errors are located like the wheelset's. */
+/* The bogie and the car (issue #28): the shipped config/bogie_default.yaml and car_default.yaml hold hm_bogie_default's
+ * and hm_car_default's values; the readers refuse each other's configs; the bogie section's errors are located like
+ * the wheelset's. */
 static void bogie_configs(void) {
   hm_bogie b, d;
   char name[HM_VEHICLE_NAME_MAX], err[256] = "";
@@ -259,6 +260,20 @@ static void bogie_configs(void) {
   HM_CHECK(hm_config_load_bogie(HM_SOURCE_DIR "/config/crh380_default.yaml", &b, name, err, sizeof err) ==
                    HM_EPARSE && strstr(err, "model: 'wheelset' where a bogie config is expected"),
            "the bogie reader on a wheelset: %s", err);
+  /* the whole vehicle: its bogies are the shipped bogie's, its carbody hm_car_default's */
+  hm_car car, car_d;
+  HM_CHECK(hm_config_load_car(HM_SOURCE_DIR "/config/car_default.yaml", &car, name, err, sizeof err) == HM_OK,
+           "load car: %s", err);
+  hm_car_default(&car_d);
+  HM_CHECK(memcmp(&car, &car_d, sizeof car) == 0 && memcmp(&car.bogie, &d, sizeof d) == 0, "car = hm_car_default");
+  HM_CHECK(car.carbody_mass_kg == 35000 && car.carbody_yaw_inertia_kg_m2 == 1.8e6 && car.half_bogie_distance_m == 8.75,
+           "carbody");
+  HM_CHECK(hm_config_load_model_kind(HM_SOURCE_DIR "/config/car_default.yaml", &kind, err, sizeof err) == HM_OK &&
+               kind == HM_MODEL_CAR, "kind of the car");
+  HM_CHECK(hm_config_load_bogie(HM_SOURCE_DIR "/config/car_default.yaml", &b, name, err, sizeof err) == HM_EPARSE &&
+               strstr(err, "model: 'car' where a bogie config is expected"), "the bogie reader on a car: %s", err);
+  HM_CHECK(hm_config_load_car(HM_SOURCE_DIR "/config/bogie_default.yaml", &car, name, err, sizeof err) == HM_EPARSE &&
+               strstr(err, "model: 'bogie' where a car config is expected"), "the car reader on a bogie: %s", err);
   const char *bogie_text = "model: bogie\n"
                            "bogie:\n"
                            "  frame_mass_kg: 2600\n  frame_yaw_inertia_kg_m2: 1800\n  half_wheelbase_m: 1.25\n"
@@ -276,7 +291,7 @@ static void bogie_configs(void) {
       {"  half_wheelbase_m: 1.25\n", "  half_wheelbase: 1.25\n", "bogie.half_wheelbase: unknown key", HM_EPARSE},
       {"  yaw_damper_stiffness_n_m: 5e7\n", "  yaw_damper_stiffness_n_m: stiff\n",
        "bogie.yaw_damper_stiffness_n_m: expected a finite number", HM_EPARSE},
-      {"model: bogie\n", "model: tram\n", "model: expected wheelset or bogie, got 'tram'", HM_EPARSE},
+      {"model: bogie\n", "model: tram\n", "model: expected wheelset, bogie or car, got 'tram'", HM_EPARSE},
       {"model: bogie\nbogie:\n", "model: bogie\nbogies:\n", "bogie: missing section", HM_EPARSE},
   };
   /* the wheelset's sections of VALID (without its monitor section), then the bogie's */

@@ -5,9 +5,10 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "bogie_rk4.h"
 #include "hm_test.h"
+#include "system_checks.h"
 #include "hunting_monitor/bogie.h"
+#include "hunting_monitor/car.h"
 #include "hunting_monitor/hopf.h"
 #include "hunting_monitor/linear.h"
 #include "hunting_monitor/system_cycles.h"
@@ -62,20 +63,32 @@ static void wheelset_folds_as_published(void) {
   HM_CHECK(ne == 2 && events[0].stable_side == 1 && events[1].stable_side == -1, "stable between the folds");
 }
 
-/* max |y1| over the last second of t_s seconds of the nonlinear bogie at v from x0 (RK4, 0.1 ms); a run that passes
- * 40 mm stops there and returns its amplitude. */
-static double simulate_amplitude(const hm_bogie_model *m, double v_kmh, const double *x0, double t_s) {
-  double x[HM_BOGIE_DIM];
-  memcpy(x, x0, sizeof x);
+/* max |x[0]| (the leading wheelset's y) over the last second of t_s seconds of the nonlinear system at v from x0
+ * (classic RK4 at 0.1 ms of its right-hand side); a run that passes 40 mm stops there and returns that. */
+static double simulate_amplitude(const hm_system *sys, double v_kmh, const double *x0, double t_s) {
+  double x[HM_SYSTEM_MAX_DIM];
+  memcpy(x, x0, sys->dim * sizeof(double));
   const double h = 1e-4, v = hm_mps_from_kmh(v_kmh);
   const long steps = (long)(t_s / h);
   double amp = 0.0;
   for (long s = 1; s <= steps; ++s) {
-    bogie_rk4_step(m, v, x, h);
+    system_rk4_step(sys, v, x, h);
     if (fabs(x[0]) > 0.04) return fabs(x[0]);
     if (s * h > t_s - 1.0) amp = fmax(amp, fabs(x[0]));
   }
   return amp;
+}
+
+/* Simulations from 20% inside and outside the family's first stable cycle above 3 mm end on it (to 1%). */
+static void settles_on_stable_cycle(const hm_system *sys, const hm_system_cycle_point *c) {
+  double x[HM_SYSTEM_MAX_DIM];
+  for (int side = -1; side <= 1; side += 2) {
+    for (size_t i = 0; i < sys->dim; ++i) x[i] = (1.0 + 0.2 * side) * c->x0[i];
+    const double a = simulate_amplitude(sys, c->speed_kmh, x, 25.0);
+    printf("  stable cycle %.3f km/h, %.4f mm: from %+.0f%% the simulation ends at %.4f mm\n", c->speed_kmh,
+           1e3 * c->amp_m, 20.0 * side, 1e3 * a);
+    HM_CHECK_DELTA(a, c->amp_m, 0.01 * c->amp_m, "settles on the stable cycle");
+  }
 }
 
 /* The default bogie's family at 0.1358: simulations from 20% inside and outside a stable cycle settle on it (within
@@ -102,17 +115,11 @@ static void bogie_cycles_where_simulations_settle(void) {
   }
   HM_CHECK(stable && unstable, "a stable cycle above 3 mm and an unstable one above 6.5 mm below 520 km/h");
   if (!stable || !unstable) return;
+  settles_on_stable_cycle(&sys, stable);
   double x[HM_BOGIE_DIM];
   for (int side = -1; side <= 1; side += 2) {
-    for (size_t i = 0; i < HM_BOGIE_DIM; ++i) x[i] = (1.0 + 0.2 * side) * stable->x0[i];
-    const double a = simulate_amplitude(&m, stable->speed_kmh, x, 25.0);
-    printf("  stable cycle %.3f km/h, %.4f mm: from %+.0f%% the simulation ends at %.4f mm\n", stable->speed_kmh,
-           1e3 * stable->amp_m, 20.0 * side, 1e3 * a);
-    HM_CHECK_DELTA(a, stable->amp_m, 0.01 * stable->amp_m, "settles on the stable cycle");
-  }
-  for (int side = -1; side <= 1; side += 2) {
     for (size_t i = 0; i < HM_BOGIE_DIM; ++i) x[i] = (1.0 + 0.02 * side) * unstable->x0[i];
-    const double a = simulate_amplitude(&m, unstable->speed_kmh, x, 3.0);
+    const double a = simulate_amplitude(&sys, unstable->speed_kmh, x, 3.0);
     printf("  unstable cycle %.3f km/h, %.4f mm: from %+.0f%% the simulation ends at %.4f mm\n", unstable->speed_kmh,
            1e3 * unstable->amp_m, 2.0 * side, 1e3 * a);
     HM_CHECK(side < 0 ? a < 0.5 * unstable->amp_m : a > 1.1 * unstable->amp_m, "leaves the unstable cycle");
@@ -120,6 +127,26 @@ static void bogie_cycles_where_simulations_settle(void) {
 }
 
 /* The bogie's first fold at rtol 1e-9 (the default) and at 1e-11 with atol 1e-14: the same to 1e-6 km/h. */
+/* The whole vehicle (30 states): its family's stable cycles are where simulations settle too. */
+static void car_cycles_where_simulations_settle(void) {
+  hm_car car;
+  hm_car_default(&car);
+  hm_car_model m;
+  hm_system sys;
+  HM_CHECK(hm_car_model_init(&m, &car, 0, &sys) == HM_OK, "init");
+  hm_system_cycle_options opt;
+  hm_system_cycle_options_default(&opt);
+  opt.amp_max_m = 0.0065;
+  size_t np = 0, ne = 0;
+  HM_CHECK(hm_system_cycles_continue(&sys, &opt, points, MAX_POINTS, &np, events, MAX_EVENTS, &ne, NULL) == HM_OK,
+           "continue");
+  const hm_system_cycle_point *stable = NULL;
+  for (size_t i = 0; i < np && !stable; ++i)
+    if (points[i].stable && points[i].amp_m > 3e-3) stable = &points[i];
+  HM_CHECK(stable != NULL, "a stable cycle above 3 mm");
+  if (stable) settles_on_stable_cycle(&sys, stable);
+}
+
 static void bogie_fold_refined(void) {
   hm_bogie_model m;
   hm_system sys;
@@ -168,6 +195,7 @@ static void bad_input(void) {
 int main(void) {
   HM_RUN(wheelset_folds_as_published);
   HM_RUN(bogie_cycles_where_simulations_settle);
+  HM_RUN(car_cycles_where_simulations_settle);
   HM_RUN(bogie_fold_refined);
   HM_RUN(bad_input);
   HM_TEST_EXIT();

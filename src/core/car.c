@@ -1,0 +1,163 @@
+/* The whole vehicle: a carbody on two bogies (see car.h). */
+#include "hunting_monitor/car.h"
+
+#include <math.h>
+#include <string.h>
+
+#include "validate.h"
+
+enum { NB = HM_BOGIE_DIM, YC = 2 * HM_BOGIE_DIM }; /* states per bogie; the carbody's first state */
+
+void hm_car_default(hm_car *car) {
+  memset(car, 0, sizeof *car);
+  hm_bogie_default(&car->bogie);
+  car->carbody_mass_kg = 35000.0;
+  car->carbody_yaw_inertia_kg_m2 = 1.8e6;
+  car->half_bogie_distance_m = 8.75;
+}
+
+hm_status hm_car_validate(const hm_car *car, char *why, size_t why_len) {
+  if (!car) {
+    (void)hm_reject(why, why_len, "car", "NULL pointer", 0.0);
+    return HM_EINVAL;
+  }
+  hm_status st = hm_bogie_validate(&car->bogie, why, why_len);
+  if (st != HM_OK) return st;
+  const hm_field_check checks[] = {
+      {"car.carbody_mass_kg", car->carbody_mass_kg, HM_RULE_POSITIVE},
+      {"car.carbody_yaw_inertia_kg_m2", car->carbody_yaw_inertia_kg_m2, HM_RULE_POSITIVE},
+      {"car.half_bogie_distance_m", car->half_bogie_distance_m, HM_RULE_POSITIVE},
+  };
+  return hm_check_fields(checks, sizeof checks / sizeof checks[0], why, why_len);
+}
+
+static const char *const CAR_BODIES[] = {"wheelsets", "bogie frame", "carbody"};
+
+static hm_status sys_rhs(const void *model, double v, const double *x, double *dx) {
+  return hm_car_rhs((const hm_car_model *)model, v, x, NULL, dx);
+}
+static hm_status sys_jac(const void *model, double v, const double *x, double *jac) {
+  return hm_car_jacobian((const hm_car_model *)model, v, x, jac);
+}
+static hm_status sys_dfdv(const void *model, double v, const double *x, double *dfdv) {
+  return hm_car_dfdv((const hm_car_model *)model, v, x, dfdv);
+}
+
+hm_status hm_car_model_init(hm_car_model *m, const hm_car *car, int carbody_held, hm_system *sys) {
+  if (!m || !car || !sys) return HM_EINVAL;
+  hm_status st = hm_car_validate(car, NULL, 0);
+  if (st != HM_OK) return st;
+  hm_car_model w;
+  memset(&w, 0, sizeof w);
+  w.car = *car;
+  w.carbody_held = carbody_held != 0;
+  hm_system bogie_sys;
+  if ((st = hm_bogie_model_init(&w.bogie, &car->bogie, 0, &bogie_sys)) != HM_OK) return st;
+  for (int j = 0; j < 2; ++j)
+    for (int i = 0; i < NB; ++i) {
+      w.inertia[NB * j + i] = w.bogie.inertia[i];
+      w.scale[NB * j + i] = w.bogie.scale[i];
+      w.body[NB * j + i] = w.bogie.body[i];
+    }
+  const double car_inertia[4] = {0.0, car->carbody_mass_kg, 0.0, car->carbody_yaw_inertia_kg_m2};
+  for (int i = 0; i < 4; ++i) {
+    w.inertia[YC + i] = car_inertia[i];
+    w.scale[YC + i] = i % 2 ? 0.1 : 1e-3;
+    w.body[YC + i] = 2;
+  }
+  *m = w;
+  *sys = (hm_system){m->carbody_held ? HM_CAR_HELD_DIM : HM_CAR_DIM, sys_rhs, sys_jac, sys_dfdv, m, 3, CAR_BODIES,
+                     m->body, m->inertia, m->scale, 0, 1, bogie_sys.odd};
+  return HM_OK;
+}
+
+hm_status hm_car_rhs(const hm_car_model *m, double v, const double *x, const double *y_track_m, double *dxdt) {
+  const hm_car *car = &m->car;
+  const double xs[2] = {car->half_bogie_distance_m, -car->half_bogie_distance_m};
+  const double *c = x + YC;
+  double dx[HM_CAR_DIM], fy = 0.0, mz = 0.0;
+  for (int j = 0; j < 2; ++j) {
+    double att[4] = {0.0, 0.0, 0.0, 0.0}, f, mo;
+    if (!m->carbody_held) att[0] = c[0] + xs[j] * c[2], att[1] = c[1] + xs[j] * c[3], att[2] = c[2], att[3] = c[3];
+    hm_status st = hm_bogie_rhs_under(&m->bogie, v, x + NB * j, y_track_m ? y_track_m + 2 * j : NULL, att,
+                                      dx + NB * j, &f, &mo);
+    if (st != HM_OK) return st;
+    fy += f;
+    mz += xs[j] * f + mo;
+  }
+  size_t n = HM_CAR_HELD_DIM;
+  if (!m->carbody_held) {
+    dx[YC] = c[1];
+    dx[YC + 1] = fy / car->carbody_mass_kg;
+    dx[YC + 2] = c[3];
+    dx[YC + 3] = mz / car->carbody_yaw_inertia_kg_m2;
+    n = HM_CAR_DIM;
+    if (!isfinite(dx[YC + 1]) || !isfinite(dx[YC + 3])) return HM_ENONFINITE;
+  }
+  memcpy(dxdt, dx, n * sizeof(double));
+  return HM_OK;
+}
+
+hm_status hm_car_jacobian(const hm_car_model *m, double v, const double *x, double *jac) {
+  const hm_car *car = &m->car;
+  const hm_bogie *b = &car->bogie;
+  const size_t n = m->carbody_held ? HM_CAR_HELD_DIM : HM_CAR_DIM;
+  const double xs[2] = {car->half_bogie_distance_m, -car->half_bogie_distance_m};
+  double J[HM_CAR_DIM * HM_CAR_DIM], block[NB * NB];
+  memset(J, 0, sizeof J);
+#define AT(i, j) J[n * (size_t)(i) + (size_t)(j)]
+  for (int j = 0; j < 2; ++j) {
+    hm_status st = hm_bogie_jacobian(&m->bogie, v, x + NB * j, block);
+    if (st != HM_OK) return st;
+    for (int r = 0; r < NB; ++r)
+      for (int q = 0; q < NB; ++q) AT(NB * j + r, NB * j + q) = block[NB * r + q];
+  }
+  if (!m->carbody_held) {
+    const double mf = b->frame_mass_kg, jf = b->frame_yaw_inertia_kg_m2, mc = car->carbody_mass_kg;
+    const double ic = car->carbody_yaw_inertia_kg_m2, ksy = b->secondary_lat_stiffness_n_m;
+    const double csy = b->secondary_lat_damping_n_s_m, dd = b->yaw_damper_half_distance_m;
+    const double kd = b->yaw_damper_stiffness_n_m, cd = b->yaw_damper_damping_n_s_m;
+    const double kyaw = 2.0 * b->airspring_long_stiffness_n_m * b->airspring_half_distance_m *
+                            b->airspring_half_distance_m + 2.0 * dd * dd * kd;
+    AT(YC, YC + 1) = 1.0;
+    AT(YC + 2, YC + 3) = 1.0;
+    for (int j = 0; j < 2; ++j) {
+      const int o = NB * j;
+      /* the frame's rows: its secondary forces follow the carbody's motion at the bogie centre */
+      AT(o + 9, YC) = ksy / mf;
+      AT(o + 9, YC + 1) = csy / mf;
+      AT(o + 9, YC + 2) = ksy * xs[j] / mf;
+      AT(o + 9, YC + 3) = csy * xs[j] / mf;
+      AT(o + 11, YC + 2) = kyaw / jf;
+      AT(o + 12, YC + 2) = -kd * dd / cd;
+      /* the carbody's rows: F_j = Ksy (yf - yc - x_j psic) + Csy (yf' - ...), M_j = kyaw (psif - psic) - 2 dd kd u */
+      AT(YC + 1, o + 8) = ksy / mc;
+      AT(YC + 1, o + 9) = csy / mc;
+      AT(YC + 1, YC) -= ksy / mc;
+      AT(YC + 1, YC + 1) -= csy / mc;
+      AT(YC + 1, YC + 2) -= ksy * xs[j] / mc;
+      AT(YC + 1, YC + 3) -= csy * xs[j] / mc;
+      AT(YC + 3, o + 8) = xs[j] * ksy / ic;
+      AT(YC + 3, o + 9) = xs[j] * csy / ic;
+      AT(YC + 3, o + 10) = kyaw / ic;
+      AT(YC + 3, o + 12) = -2.0 * dd * kd / ic;
+      AT(YC + 3, YC) -= xs[j] * ksy / ic;
+      AT(YC + 3, YC + 1) -= xs[j] * csy / ic;
+      AT(YC + 3, YC + 2) -= (xs[j] * xs[j] * ksy + kyaw) / ic;
+      AT(YC + 3, YC + 3) -= xs[j] * xs[j] * csy / ic;
+    }
+  }
+#undef AT
+  memcpy(jac, J, n * n * sizeof(double));
+  return HM_OK;
+}
+
+hm_status hm_car_dfdv(const hm_car_model *m, double v, const double *x, double *dfdv) {
+  const size_t n = m->carbody_held ? HM_CAR_HELD_DIM : HM_CAR_DIM;
+  for (size_t i = 0; i < n; ++i) dfdv[i] = 0.0;
+  for (int j = 0; j < 2; ++j) {
+    hm_status st = hm_bogie_dfdv(&m->bogie, v, x + NB * j, dfdv + NB * j);
+    if (st != HM_OK) return st;
+  }
+  return HM_OK;
+}
