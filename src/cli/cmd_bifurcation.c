@@ -317,8 +317,9 @@ static void write_system_events(json_writer *w, const char *key, const hm_system
   jw_end_array(w);
 }
 
-static void write_system_family(FILE *f, const hm_system *sys, const hm_system_cycle_point *pts, size_t np,
-                               const hm_system_cycle_event *ev, size_t ne, const hm_cont_stats *st, int csv) {
+static void write_system_family(FILE *f, const hm_system *sys, const hm_vehicle *wheelset,
+                                const hm_system_cycle_point *pts, size_t np, const hm_system_cycle_event *ev, size_t ne,
+                                const hm_cont_stats *st, int csv) {
   if (csv) {
     fprintf(f, "v_kmh,amplitude_m,period_s,stable,n_unstable,max_multiplier_modulus\n");
     for (size_t i = 0; i < np; ++i)
@@ -342,6 +343,9 @@ static void write_system_family(FILE *f, const hm_system *sys, const hm_system_c
   jw_number(&w, "frequency_hz", have_hopf ? spec.frequency_hz : NAN);
   jw_string(&w, "mode", have_hopf ? sys->body_names[spec.dominant_body] : "");
   jw_string(&w, "kind", np > 1 ? (pts[1].speed_kmh < pts[0].speed_kmh ? "subcritical" : "supercritical") : "");
+  jw_number(&w, "conicity", cli_conicity0(wheelset));
+  jw_number(&w, "kx_mn_m", wheelset->stiffness_long_n_m / 1e6);
+  jw_number(&w, "ky_mn_m", wheelset->stiffness_lat_n_m / 1e6);
   jw_end_object(&w);
   write_system_events(&w, "folds", ev, ne, HM_CYCLE_LPC);
   write_system_events(&w, "branch_points", ev, ne, HM_CYCLE_BPC);
@@ -411,7 +415,7 @@ static int cycles_system(const cli_args *a, hm_model_kind kind) {
     rc = 1;
   }
   if (rc == 0) {
-    write_system_family(f, sys, pts, np, ev, ne, &cs, cli_has(a, "csv"));
+    write_system_family(f, sys, &cm.wheelset, pts, np, ev, ne, &cs, cli_has(a, "csv"));
     if (path && fclose(f) != 0) {
       perror(path);
       rc = 1;
