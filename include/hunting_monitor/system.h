@@ -84,6 +84,11 @@ void hm_system_critical_options_default(hm_system_critical_options *opt);
  * otherwise. */
 hm_status hm_system_validate(const hm_system *sys);
 
+/* The eigenvalues of df/dx at x = 0 and speed_mps in dgeev's order (re, im: dim each), and with vr != NULL its right
+ * eigenvectors (column-major dim x dim, dgeev's packing: a pair's real and imaginary parts in columns k, k + 1). No
+ * validation of sys (the callers' own); HM_ELAPACK, HM_ENONFINITE. */
+hm_status hm_system_eig(const hm_system *sys, double speed_mps, double *re, double *im, double *vr);
+
 /* The spectrum of df/dx at x = 0 and speed_mps (> 0). out untouched on failure. */
 hm_status hm_system_spectrum_at(const hm_system *sys, double speed_mps, hm_system_spectrum *out);
 

@@ -53,9 +53,7 @@ static void sort_spectrum(size_t n, double *re, double *im, int *perm) {
   }
 }
 
-/* Eigenvalues of the Jacobian at the origin, sorted; with vr != NULL also the right eigenvectors (column-major,
- * dgeev's packing: a pair's real and imaginary parts in columns k, k+1) and perm[i] the unsorted index of re[i]. */
-static hm_status eig_at(const hm_system *sys, double speed_mps, double *re, double *im, double *vr, int *perm) {
+hm_status hm_system_eig(const hm_system *sys, double speed_mps, double *re, double *im, double *vr) {
   const int n = (int)sys->dim, one = 1, lwork = LWORK;
   double jac[N_MAX * N_MAX], a[N_MAX * N_MAX], work[LWORK], dummy[1], x0[N_MAX];
   memset(x0, 0, sizeof x0);
@@ -69,10 +67,17 @@ static hm_status eig_at(const hm_system *sys, double speed_mps, double *re, doub
   int info = 0;
   dgeev_("N", vr ? "V" : "N", &n, a, &n, re, im, dummy, &one, vr ? vr : dummy, vr ? &n : &one, work, &lwork, &info,
          1, 1);
-  if (info != 0) return HM_ELAPACK;
+  return info == 0 ? HM_OK : HM_ELAPACK;
+}
+
+/* Eigenvalues of the Jacobian at the origin, sorted; with vr != NULL also the right eigenvectors (dgeev's packing)
+ * and perm[i] the unsorted index of re[i]. */
+static hm_status eig_at(const hm_system *sys, double speed_mps, double *re, double *im, double *vr, int *perm) {
+  hm_status st = hm_system_eig(sys, speed_mps, re, im, vr);
+  if (st != HM_OK) return st;
   int local[N_MAX];
-  for (int i = 0; i < n; ++i) local[i] = i;
-  sort_spectrum((size_t)n, re, im, perm ? perm : local);
+  for (size_t i = 0; i < sys->dim; ++i) local[i] = (int)i;
+  sort_spectrum(sys->dim, re, im, perm ? perm : local);
   return HM_OK;
 }
 

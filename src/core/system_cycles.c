@@ -9,7 +9,6 @@
 #include "hunting_monitor/linear.h"
 #include "continuation.h"
 #include "floquet.h"
-#include "lapack.h"
 #include "shooting.h"
 
 enum { NMAX = HM_SYSTEM_MAX_DIM, UMAX = HM_SYSTEM_MAX_DIM + 1, ZMAX = NMAX + NMAX * NMAX + NMAX };
@@ -291,15 +290,8 @@ static hm_status start_guess(const shooter *c, const hm_system_cycle_options *op
   double v_mps;
   hm_status st = hm_system_critical_speed(&c->sys, &copt, &v_mps, NULL);
   if (st != HM_OK) return st;
-  double jac[NMAX * NMAX], a[NMAX * NMAX], vr[NMAX * NMAX], re[NMAX], im[NMAX], work[8 * NMAX], dummy[1], x0[NMAX];
-  memset(x0, 0, sizeof x0);
-  if ((st = c->sys.jacobian(c->sys.model, v_mps, x0, jac)) != HM_OK) return st;
-  for (size_t i = 0; i < n; ++i)
-    for (size_t j = 0; j < n; ++j) a[i + n * j] = jac[n * i + j];
-  const int nn = (int)n, one = 1, lwork = 8 * NMAX;
-  int info = 0;
-  dgeev_("N", "V", &nn, a, &nn, re, im, dummy, &one, vr, &nn, work, &lwork, &info, 1, 1);
-  if (info != 0) return HM_ELAPACK;
+  double vr[NMAX * NMAX], re[NMAX], im[NMAX], x0[NMAX];
+  if ((st = hm_system_eig(&c->sys, v_mps, re, im, vr)) != HM_OK) return st;
   size_t k = n;
   for (size_t i = 0; i < n; ++i)
     if (im[i] > 0.0 && (k == n || re[i] > re[k])) k = i;

@@ -1,0 +1,63 @@
+/*
+ * hunting_monitor - the hunting mode of any vehicle model (wheelset, bogie, car) as a function of the wheels'
+ * equivalent conicity lambda(0) and the speed: the identified mode read as a conicity and a Hopf speed by that model
+ * (issue #28; inversion.h does the same in closed form for the wheelset alone).
+ *
+ * The model's conicity is set by shifting the constant of every wheelset's lambda(y) (hm_vehicle_set_conicity_at_zero).
+ * Its hunting root at (lambda, v) is the eigenvalue of the Jacobian at the origin (dgeev) with a positive imaginary
+ * part nearest a reference mode s_ref = sigma_ref + i 2 pi f_ref in the measured errors' metric
+ * ((Re s - sigma_ref) / e_sigma)^2 + ((Im s - w_ref) / e_w)^2: a bogie has several oscillatory modes, and the one the
+ * accelerometer shows is the one to follow.
+ * The inversion minimises the same weighted misfit of the root from the measured mode over lambda: the start from a
+ * scan of HM_MODE_MODEL_SCAN conicities over [0.01, 1] (the root nearest the measured mode at each), then Gauss-Newton
+ * with the sensitivity ds/dlambda by central differences (step 1e-6 lambda), the root followed from the last one;
+ * converged when the step is below tol; HM_ENOCONV after max_iter or outside 0 < lambda < 10. Its standard error and
+ * chi2 as inversion.h's. For the wheelset it gives inversion.h's numbers (test_mode_model: to 1e-7).
+ * The Hopf speed at a conicity: hm_system_critical_speed (100-1500 km/h, 5 km/h scan, bisection to 1e-6 km/h), the
+ * first crossing of any mode, and whose mode that is.
+ * One model is used by one thread at a time (it holds its parameters and system); create allocates, nothing after.
+ */
+#ifndef HUNTING_MONITOR_MODE_MODEL_H
+#define HUNTING_MONITOR_MODE_MODEL_H
+
+#include "hunting_monitor/bogie.h"
+#include "hunting_monitor/car.h"
+#include "hunting_monitor/inversion.h"
+#include "hunting_monitor/model.h"
+#include "hunting_monitor/status.h"
+#include "hunting_monitor/system.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+#define HM_MODE_MODEL_SCAN 40
+
+typedef struct hm_mode_model_s *hm_mode_model;
+
+/* A model of the wheelset, the bogie or the car; validated (HM_EDOMAIN), HM_ENOMEM; *out untouched on failure. */
+hm_status hm_mode_model_create_wheelset(const hm_vehicle *veh, hm_mode_model *out);
+hm_status hm_mode_model_create_bogie(const hm_bogie *bogie, hm_mode_model *out);
+hm_status hm_mode_model_create_car(const hm_car *car, hm_mode_model *out);
+void hm_mode_model_destroy(hm_mode_model m);
+
+hm_model_kind hm_mode_model_kind(const hm_mode_model m);
+
+/* The hunting root at conicity and speed nearest the reference mode (errors e_sigma [1/s], e_f [Hz] > 0 weigh the
+ * distance): its decay rate [1/s] and frequency [Hz]. HM_ENOCRIT if no oscillatory mode. */
+hm_status hm_mode_model_root(hm_mode_model m, double conicity, double speed_kmh, double sigma_ref, double e_sigma,
+                             double f_ref_hz, double e_f, double *sigma_1_s, double *f_hz);
+
+/* The linear critical speed at a conicity [km/h], its frequency [Hz] and the body its mode moves (system.h's
+ * body index; NULLs allowed). HM_ENOCRIT if none in 100-1500 km/h. */
+hm_status hm_mode_model_hopf(hm_mode_model m, double conicity, double *speed_kmh, double *f_hz, int *body);
+
+/* The conicity whose hunting root is nearest the measured mode (above); inputs as inversion.h's. */
+hm_status hm_mode_model_invert(hm_mode_model m, double speed_kmh, double sigma_m, double e_sigma, double f_m,
+                               double e_f, double tol, unsigned max_iter, hm_conicity_inversion *out);
+
+#ifdef __cplusplus
+}
+#endif
+
+#endif

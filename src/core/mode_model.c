@@ -1,0 +1,204 @@
+/* The hunting mode of any vehicle model against the conicity (see mode_model.h). */
+#include "hunting_monitor/mode_model.h"
+
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "hunting_monitor/linear.h"
+
+enum { NMAX = HM_SYSTEM_MAX_DIM };
+
+struct hm_mode_model_s {
+  hm_model_kind kind;
+  hm_car params;         /* the car's, or its bogie's, or its bogie's wheelset's: the conicity set in place */
+  hm_wheelset_system ws; /* the system of the kind, at the conicity last set */
+  hm_bogie_model bogie;
+  hm_car_model car;
+  hm_system sys;
+  double conicity;       /* the conicity the system holds (NAN: none yet) */
+};
+
+static hm_status set_conicity(hm_mode_model m, double conicity) {
+  if (m->conicity == conicity) return HM_OK;
+  hm_vehicle *w = &m->params.bogie.wheelset;
+  hm_status st = hm_vehicle_set_conicity_at_zero(w, conicity);
+  if (st != HM_OK) return st;
+  switch (m->kind) {
+    case HM_MODEL_WHEELSET: st = hm_wheelset_system_init(&m->ws, w, &m->sys); break;
+    case HM_MODEL_BOGIE: st = hm_bogie_model_init(&m->bogie, &m->params.bogie, 0, &m->sys); break;
+    case HM_MODEL_CAR: st = hm_car_model_init(&m->car, &m->params, 0, &m->sys); break;
+    default: st = HM_EINVAL;
+  }
+  m->conicity = st == HM_OK ? conicity : NAN;
+  return st;
+}
+
+static hm_status create(hm_model_kind kind, const hm_car *params, hm_mode_model *out) {
+  if (!out) return HM_EINVAL;
+  hm_mode_model m = calloc(1, sizeof *m);
+  if (!m) return HM_ENOMEM;
+  m->kind = kind;
+  m->params = *params;
+  m->conicity = NAN;
+  double l0;
+  hm_conicity_eval(&params->bogie.wheelset.conicity, 0.0, &l0, NULL);
+  hm_status st = set_conicity(m, l0);
+  if (st != HM_OK) {
+    free(m);
+    return st;
+  }
+  *out = m;
+  return HM_OK;
+}
+
+hm_status hm_mode_model_create_wheelset(const hm_vehicle *veh, hm_mode_model *out) {
+  if (!veh) return HM_EINVAL;
+  hm_status st = hm_vehicle_validate(veh, NULL, 0);
+  if (st != HM_OK) return st;
+  hm_car c;
+  hm_car_default(&c);
+  c.bogie.wheelset = *veh;
+  return create(HM_MODEL_WHEELSET, &c, out);
+}
+
+hm_status hm_mode_model_create_bogie(const hm_bogie *bogie, hm_mode_model *out) {
+  if (!bogie) return HM_EINVAL;
+  hm_status st = hm_bogie_validate(bogie, NULL, 0);
+  if (st != HM_OK) return st;
+  hm_car c;
+  hm_car_default(&c);
+  c.bogie = *bogie;
+  return create(HM_MODEL_BOGIE, &c, out);
+}
+
+hm_status hm_mode_model_create_car(const hm_car *car, hm_mode_model *out) {
+  if (!car) return HM_EINVAL;
+  hm_status st = hm_car_validate(car, NULL, 0);
+  if (st != HM_OK) return st;
+  return create(HM_MODEL_CAR, car, out);
+}
+
+void hm_mode_model_destroy(hm_mode_model m) { free(m); }
+
+hm_model_kind hm_mode_model_kind(const hm_mode_model m) { return m->kind; }
+
+/* The root with im > 0 nearest (sigma_ref, w_ref) in the metric of (e_sigma, e_w). */
+static hm_status nearest_root(hm_mode_model m, double conicity, double v_kmh, double sigma_ref, double e_sigma,
+                              double w_ref, double e_w, double *sigma, double *w) {
+  hm_status st = set_conicity(m, conicity);
+  if (st != HM_OK) return st;
+  const size_t n = m->sys.dim;
+  double re[NMAX], im[NMAX];
+  if ((st = hm_system_eig(&m->sys, hm_mps_from_kmh(v_kmh), re, im, NULL)) != HM_OK) return st;
+  double best = INFINITY;
+  size_t k = n;
+  for (size_t i = 0; i < n; ++i) {
+    if (!(im[i] > 0.0)) continue;
+    const double dr = (re[i] - sigma_ref) / e_sigma, di = (im[i] - w_ref) / e_w, d = dr * dr + di * di;
+    if (d < best) best = d, k = i;
+  }
+  if (k == n) return HM_ENOCRIT;
+  *sigma = re[k];
+  *w = im[k];
+  return HM_OK;
+}
+
+static int inputs_ok(double v_kmh, double e_sigma, double e_f) {
+  return v_kmh > 0.0 && v_kmh < 1e4 && e_sigma > 0.0 && isfinite(e_sigma) && e_f > 0.0 && isfinite(e_f);
+}
+
+hm_status hm_mode_model_root(hm_mode_model m, double conicity, double speed_kmh, double sigma_ref, double e_sigma,
+                             double f_ref_hz, double e_f, double *sigma_1_s, double *f_hz) {
+  if (!m || !sigma_1_s || !f_hz || !inputs_ok(speed_kmh, e_sigma, e_f) || !isfinite(sigma_ref) ||
+      !isfinite(f_ref_hz) || !isfinite(conicity) || conicity < 0.0)
+    return HM_EDOMAIN;
+  double s, w;
+  hm_status st = nearest_root(m, conicity, speed_kmh, sigma_ref, e_sigma, 2.0 * HM_PI * f_ref_hz,
+                              2.0 * HM_PI * e_f, &s, &w);
+  if (st != HM_OK) return st;
+  *sigma_1_s = s;
+  *f_hz = w / (2.0 * HM_PI);
+  return HM_OK;
+}
+
+hm_status hm_mode_model_hopf(hm_mode_model m, double conicity, double *speed_kmh, double *f_hz, int *body) {
+  if (!m || !speed_kmh || !isfinite(conicity) || conicity < 0.0) return HM_EDOMAIN;
+  hm_status st = set_conicity(m, conicity);
+  if (st != HM_OK) return st;
+  const hm_system_critical_options opt = {hm_mps_from_kmh(100.0), hm_mps_from_kmh(1500.0), hm_mps_from_kmh(5.0),
+                                          hm_mps_from_kmh(1e-6)};
+  double v;
+  hm_system_spectrum s;
+  if ((st = hm_system_critical_speed(&m->sys, &opt, &v, &s)) != HM_OK) return st;
+  *speed_kmh = hm_kmh_from_mps(v);
+  if (f_hz) *f_hz = s.frequency_hz;
+  if (body) *body = s.dominant_body;
+  return HM_OK;
+}
+
+/* The misfit's residuals and their sensitivities at lambda, following the root from (*sr, *wr). */
+typedef struct {
+  double s, w, ds, dw; /* the root and d root / d lambda */
+} root_point;
+
+static hm_status root_with_slope(hm_mode_model m, double lambda, double v_kmh, double e_sigma, double e_w, double *sr,
+                                 double *wr, root_point *p) {
+  const double h = 1e-6 * fmax(lambda, 1e-3);
+  double s0, w0, sp, wp, sm, wm;
+  hm_status st = nearest_root(m, lambda, v_kmh, *sr, e_sigma, *wr, e_w, &s0, &w0);
+  if (st == HM_OK) st = nearest_root(m, lambda + h, v_kmh, s0, e_sigma, w0, e_w, &sp, &wp);
+  if (st == HM_OK) st = nearest_root(m, fmax(lambda - h, 0.0), v_kmh, s0, e_sigma, w0, e_w, &sm, &wm);
+  if (st != HM_OK) return st;
+  const double span = lambda + h - fmax(lambda - h, 0.0);
+  *p = (root_point){s0, w0, (sp - sm) / span, (wp - wm) / span};
+  *sr = s0, *wr = w0;
+  return HM_OK;
+}
+
+hm_status hm_mode_model_invert(hm_mode_model m, double speed_kmh, double sigma_m, double e_sigma, double f_m,
+                               double e_f, double tol, unsigned max_iter, hm_conicity_inversion *out) {
+  if (!m || !out) return HM_EINVAL;
+  if (!inputs_ok(speed_kmh, e_sigma, e_f) || !(sigma_m < 0.0) || !isfinite(sigma_m) || !(f_m > 0.0 && f_m < 1e3) ||
+      !(tol > 0.0) || max_iter < 1)
+    return HM_EDOMAIN;
+  const double w_m = 2.0 * HM_PI * f_m, e_w = 2.0 * HM_PI * e_f;
+  /* the start: the scanned conicity whose nearest root is nearest the measured mode */
+  double lambda = NAN, best = INFINITY;
+  for (int k = 0; k < HM_MODE_MODEL_SCAN; ++k) {
+    const double l = 0.01 * pow(100.0, (double)k / (HM_MODE_MODEL_SCAN - 1)); /* 0.01..1, geometric */
+    double s, w;
+    if (nearest_root(m, l, speed_kmh, sigma_m, e_sigma, w_m, e_w, &s, &w) != HM_OK) continue;
+    const double dr = (s - sigma_m) / e_sigma, di = (w - w_m) / e_w, d = dr * dr + di * di;
+    if (d < best) best = d, lambda = l;
+  }
+  if (!isfinite(lambda)) return HM_ENOCONV;
+  double sr = sigma_m, wr = w_m;
+  for (unsigned it = 1; it <= max_iter; ++it) {
+    root_point p;
+    if (root_with_slope(m, lambda, speed_kmh, e_sigma, e_w, &sr, &wr, &p) != HM_OK) return HM_ENOCONV;
+    const double jr = p.ds / e_sigma, ji = p.dw / e_w, rr = (p.s - sigma_m) / e_sigma, ri = (p.w - w_m) / e_w;
+    const double jj = jr * jr + ji * ji;
+    if (!(jj > 0.0) || !isfinite(jj)) return HM_ENOCONV;
+    double step = -(jr * rr + ji * ri) / jj;
+    step = fmax(fmin(step, 0.5 * lambda + 0.01), -0.5 * lambda); /* keep lambda positive */
+    lambda += step;
+    if (fabs(step) > tol) continue;
+    if (!(lambda > 0.0 && lambda < 10.0)) return HM_ENOCONV;
+    if (root_with_slope(m, lambda, speed_kmh, e_sigma, e_w, &sr, &wr, &p) != HM_OK) return HM_ENOCONV;
+    const double j1 = p.ds / e_sigma, j2 = p.dw / e_w, r1 = (p.s - sigma_m) / e_sigma, r2 = (p.w - w_m) / e_w;
+    hm_conicity_inversion r;
+    memset(&r, 0, sizeof r);
+    r.conicity = lambda;
+    r.conicity_se = 1.0 / sqrt(j1 * j1 + j2 * j2);
+    r.chi2 = r1 * r1 + r2 * r2;
+    r.model_decay_rate_1_s = p.s;
+    r.model_frequency_hz = p.w / (2.0 * HM_PI);
+    r.dsigma_dconicity = p.ds;
+    r.dfrequency_dconicity = p.dw / (2.0 * HM_PI);
+    r.iterations = it;
+    *out = r;
+    return HM_OK;
+  }
+  return HM_ENOCONV;
+}

@@ -1,0 +1,114 @@
+/* mode_model.h: the identified mode read as a conicity and a Hopf speed by any vehicle model. For the wheelset
+ * against inversion.h's closed-form inversion and linear.h's closed-form Hopf speed; for the bogie and the car
+ * against their own modes (the conicity that made a root is found again from it) and their critical speeds. */
+#include <string.h>
+
+#include "hm_test.h"
+#include "hunting_monitor/linear.h"
+#include "hunting_monitor/mode_model.h"
+
+static void wheelset_as_inversion_h(void) {
+  hm_vehicle veh;
+  hm_vehicle_default(&veh);
+  hm_mode_model m = NULL;
+  HM_CHECK(hm_mode_model_create_wheelset(&veh, &m) == HM_OK && m, "create");
+  if (!m) return;
+  hm_linear_coef coef;
+  hm_linear_coef_from_vehicle(&veh, &coef);
+  const double cases[][4] = {/* conicity, speed, and an offset of the measured mode from the root (1/s, Hz) */
+                             {0.12, 400.0, 0.0, 0.0}, {0.16, 450.0, 0.3, -0.05}, {0.20, 300.0, -0.5, 0.1},
+                             {0.30, 250.0, 0.2, 0.2}};
+  for (int k = 0; k < 4; ++k) {
+    double s, w;
+    HM_CHECK(hm_hunting_root(&coef, cases[k][1], cases[k][0], &s, &w) == HM_OK, "root");
+    const double sm = s + cases[k][2], fm = w / (2.0 * HM_PI) + cases[k][3];
+    hm_conicity_inversion a, b;
+    HM_CHECK(hm_conicity_from_mode(&coef, cases[k][1], sm, 0.2, fm, 0.05, 1e-10, 50, &a) == HM_OK, "inversion.h");
+    HM_CHECK(hm_mode_model_invert(m, cases[k][1], sm, 0.2, fm, 0.05, 1e-10, 50, &b) == HM_OK, "mode model");
+    HM_CHECK_DELTA(b.conicity, a.conicity, 1e-7, "conicity");
+    HM_CHECK_REL(b.conicity_se, a.conicity_se, 1e-5, "its standard error");
+    HM_CHECK_DELTA(b.chi2, a.chi2, 1e-6 * (1.0 + a.chi2), "chi2");
+    HM_CHECK_DELTA(b.model_frequency_hz, a.model_frequency_hz, 1e-8, "model frequency");
+    if (cases[k][2] == 0.0) HM_CHECK_DELTA(b.conicity, cases[k][0], 1e-8, "the root's own conicity");
+  }
+  const double lambdas[] = {0.08, 0.1358, 0.25};
+  for (int k = 0; k < 3; ++k) {
+    double v = 0.0, f = 0.0, v_closed = 0.0, omega = 0.0;
+    int body = -1;
+    HM_CHECK(hm_mode_model_hopf(m, lambdas[k], &v, &f, &body) == HM_OK, "hopf");
+    HM_CHECK(hm_linear_critical_speed(&veh, lambdas[k], &v_closed) == HM_OK && hm_linear_hopf_omega(&veh, &omega) == 0,
+             "closed form");
+    HM_CHECK_DELTA(v, hm_kmh_from_mps(v_closed), 1e-5, "Hopf speed against the closed form");
+    HM_CHECK_DELTA(f, omega / (2.0 * HM_PI), 1e-6, "its frequency");
+    HM_CHECK(body == 0, "the wheelset's mode");
+  }
+  hm_mode_model_destroy(m);
+}
+
+/* The bogie and the car: the conicity that made a mode is found from it again (the root followed among their 6 and
+ * 15 oscillatory pairs), and the Hopf speed is the system's critical speed. */
+static void bogie_and_car_find_their_own_conicity(void) {
+  hm_bogie b;
+  hm_bogie_default(&b);
+  hm_car c;
+  hm_car_default(&c);
+  for (int kind = 0; kind < 2; ++kind) {
+    hm_mode_model m = NULL;
+    HM_CHECK((kind ? hm_mode_model_create_car(&c, &m) : hm_mode_model_create_bogie(&b, &m)) == HM_OK && m, "create");
+    if (!m) continue;
+    const double lambdas[] = {0.10, 0.17, 0.25}, speeds[] = {480.0, 400.0, 320.0};
+    for (int k = 0; k < 3; ++k) {
+      /* the wheelsets' mode at that conicity: the root nearest 14 Hz, well damped or not */
+      double s = 0.0, f = 0.0;
+      HM_CHECK(hm_mode_model_root(m, lambdas[k], speeds[k], -2.0, 5.0, 14.0, 2.0, &s, &f) == HM_OK, "root");
+      hm_conicity_inversion r;
+      HM_CHECK(hm_mode_model_invert(m, speeds[k], s, 0.2, f, 0.05, 1e-10, 50, &r) == HM_OK, "invert");
+      printf("  %s at %.2f, %.0f km/h: mode %.4f 1/s at %.4f Hz -> conicity %.8f +- %.5f\n", kind ? "car" : "bogie",
+             lambdas[k], speeds[k], s, f, r.conicity, r.conicity_se);
+      HM_CHECK_DELTA(r.conicity, lambdas[k], 1e-7, "the conicity found again");
+      HM_CHECK(r.chi2 < 1e-10, "and the mode explained exactly (chi2 %.3g)", r.chi2);
+    }
+    double v = 0.0, f = 0.0;
+    int body = -1;
+    HM_CHECK(hm_mode_model_hopf(m, 0.1358, &v, &f, &body) == HM_OK, "hopf");
+    hm_system sys;
+    hm_bogie_model bm;
+    hm_car_model cm;
+    HM_CHECK((kind ? hm_car_model_init(&cm, &c, 0, &sys) : hm_bogie_model_init(&bm, &b, 0, &sys)) == HM_OK, "sys");
+    hm_system_critical_options opt;
+    hm_system_critical_options_default(&opt);
+    double vc = 0.0;
+    HM_CHECK(hm_system_critical_speed(&sys, &opt, &vc, NULL) == HM_OK, "critical");
+    HM_CHECK_DELTA(v, hm_kmh_from_mps(vc), 1e-5, "Hopf speed as the system's critical speed");
+    HM_CHECK(body == 0, "the wheelsets' mode at 0.1358");
+    hm_mode_model_destroy(m);
+  }
+}
+
+static void bad_input(void) {
+  hm_vehicle veh;
+  hm_vehicle_default(&veh);
+  hm_mode_model m = NULL;
+  veh.mass_kg = -1.0;
+  HM_CHECK(hm_mode_model_create_wheelset(&veh, &m) == HM_EDOMAIN && m == NULL, "negative mass");
+  hm_vehicle_default(&veh);
+  HM_CHECK(hm_mode_model_create_wheelset(&veh, &m) == HM_OK, "create");
+  hm_conicity_inversion r;
+  memset(&r, 0x5a, sizeof r);
+  const unsigned char before = ((unsigned char *)&r)[0];
+  HM_CHECK(hm_mode_model_invert(m, 400.0, 0.5, 0.2, 14.0, 0.05, 1e-10, 50, &r) == HM_EDOMAIN, "a growing mode");
+  HM_CHECK(hm_mode_model_invert(m, NAN, -1.0, 0.2, 14.0, 0.05, 1e-10, 50, &r) == HM_EDOMAIN, "NaN speed");
+  HM_CHECK(hm_mode_model_invert(m, 400.0, -1.0, 0.0, 14.0, 0.05, 1e-10, 50, &r) == HM_EDOMAIN, "zero error");
+  HM_CHECK(((unsigned char *)&r)[0] == before, "output untouched");
+  double v = -1.0;
+  HM_CHECK(hm_mode_model_hopf(m, -0.1, &v, NULL, NULL) == HM_EDOMAIN && v == -1.0, "negative conicity");
+  HM_CHECK(hm_mode_model_hopf(m, 0.001, &v, NULL, NULL) == HM_ENOCRIT && v == -1.0, "no Hopf point in range");
+  hm_mode_model_destroy(m);
+}
+
+int main(void) {
+  HM_RUN(wheelset_as_inversion_h);
+  HM_RUN(bogie_and_car_find_their_own_conicity);
+  HM_RUN(bad_input);
+  HM_TEST_EXIT();
+}
