@@ -68,7 +68,7 @@ typedef struct {
   hm_bogie bogie;
   hm_linear_coef coef;  /* the wheelset's coefficients (MODEL.md section 2) */
   int frame_held;       /* 1: the frame held at rest, 8 states */
-  double inertia[HM_BOGIE_DIM], scale[HM_BOGIE_DIM];
+  double inertia[HM_BOGIE_DIM], scale[HM_BOGIE_DIM], x_m[2];
   int body[HM_BOGIE_DIM];
 } hm_bogie_model;
 
@@ -87,6 +87,10 @@ hm_status hm_bogie_rhs(const hm_bogie_model *m, double speed_mps, const double *
  * force [N] and yaw moment [N m] on the carbody there. (hm_bogie_rhs: att = 0.) Not for a held frame. */
 hm_status hm_bogie_rhs_under(const hm_bogie_model *m, double speed_mps, const double *x, const double *y_track_m,
                              const double att[4], double *dxdt, double *force_on_car_n, double *moment_on_car_nm);
+
+/* Where an accelerometer sits: "axlebox" (the leading wheelset's lateral acceleration y1''), "frame" (the frame's
+ * over the leading axle, yf'' + b psif''; not with the frame held). HM_EINVAL for another name. */
+hm_status hm_bogie_sensor(const hm_bogie_model *m, const char *where, hm_sensor_point *out);
 
 /* df/dv [per m/s] (the creep damping's 1/v terms). */
 hm_status hm_bogie_dfdv(const hm_bogie_model *m, double speed_mps, const double *x, double *dfdv);

@@ -48,12 +48,16 @@ typedef struct {
   hm_car car;
   hm_bogie_model bogie;   /* the bogies' equations (frame free) */
   int carbody_held;
-  double inertia[HM_CAR_DIM], scale[HM_CAR_DIM];
+  double inertia[HM_CAR_DIM], scale[HM_CAR_DIM], x_m[4];
   int body[HM_CAR_DIM];
 } hm_car_model;
 
 /* Validate and fill *m and *sys (sys points into m). Bodies: 0 "wheelsets", 1 "bogie frame", 2 "carbody". */
 hm_status hm_car_model_init(hm_car_model *m, const hm_car *car, int carbody_held, hm_system *sys);
+
+/* Where an accelerometer sits: "axlebox" (the leading wheelset), "frame" (the leading bogie's frame over its
+ * leading axle), "carbody" (the carbody over the leading bogie's centre, yc'' + a psic''; not with it held). */
+hm_status hm_car_sensor(const hm_car_model *m, const char *where, hm_sensor_point *out);
 
 /* f(x; v), the track under the four wheelsets y_track_m[4] (leading first; NULL: 0). */
 hm_status hm_car_rhs(const hm_car_model *m, double speed_mps, const double *x, const double *y_track_m, double *dxdt);

@@ -1,8 +1,10 @@
 /*
- * hunting_monitor - the sensor streams of a simulated run: the nonlinear wheelset model (model.h) driven along a
- * speed profile over a random track (excitation.h), integrated by Dormand-Prince 5(4) (integrate.h), sampled like
- * an axle-box accelerometer (lateral acceleration y'' = x2' of MODEL.md's equations at a fixed rate, plus white
- * Gaussian noise) and a speedometer. One implementation for `hunting simulate`, hunting_sim_node and the tests.
+ * hunting_monitor - the sensor streams of a simulated run: the nonlinear wheelset model (model.h), or any model
+ * (system.h: a bogie, a car) with an accelerometer where it is (a sensor point: an axle box, the frame, the carbody),
+ * driven along a speed profile over a random track (excitation.h; a model's wheelsets meet it one after another at
+ * their spacing), integrated by Dormand-Prince 5(4) (integrate.h), sampled like an accelerometer (the lateral
+ * acceleration there at a fixed rate, plus white Gaussian noise; the wheelset's is its axle box, y'' = x2' of
+ * MODEL.md's equations) and a speedometer. One implementation for `hunting simulate`, hunting_sim_node and the tests.
  *
  * Sample k of a stream is taken at t = k / rate exactly (no accumulated drift), from the integrator's dense
  * output; speed samples due at or before an acceleration sample are delivered first. The noise comes from one
@@ -17,6 +19,7 @@
 #include "hunting_monitor/excitation.h"
 #include "hunting_monitor/model.h"
 #include "hunting_monitor/status.h"
+#include "hunting_monitor/system.h"
 
 #ifdef __cplusplus
 extern "C" {
@@ -44,8 +47,9 @@ void hm_sensor_sim_config_default(hm_sensor_sim_config *cfg);
 
 /* Where the samples go. Each callback may be NULL; a nonzero return stops the run at that sample. */
 typedef struct {
-  /* measured = true + noise [m/s^2]; x = (y [m], dy/dt [m/s], psi [rad], dpsi/dt [rad/s]), the true state */
-  int (*accel)(void *ctx, double t_s, double measured_mps2, double true_mps2, const double x[4]);
+  /* measured = true + noise [m/s^2]; x the true state (the wheelset's (y [m], dy/dt [m/s], psi [rad], dpsi/dt
+   * [rad/s]); a system's hm_sensor_sim_dim states) */
+  int (*accel)(void *ctx, double t_s, double measured_mps2, double true_mps2, const double *x);
   int (*speed)(void *ctx, double t_s, double speed_kmh);
   void *ctx;
 } hm_sensor_sink;
@@ -58,18 +62,25 @@ typedef struct hm_sensor_sim_s *hm_sensor_sim;
  * when scale > 0). */
 hm_status hm_sensor_sim_create(const hm_vehicle *veh, const hm_sensor_sim_config *cfg, const double x0[4],
                                hm_sensor_sim *out, char *why, size_t why_len);
+/* A run of the system sys (its model kept by the caller) with the accelerometer at point; x0 of sys->dim states or
+ * NULL; the same checks and errors (HM_EINVAL also for an invalid system or a point off it). */
+hm_status hm_sensor_sim_create_system(const hm_system *sys, const hm_sensor_point *point,
+                                      const hm_sensor_sim_config *cfg, const double *x0, hm_sensor_sim *out,
+                                      char *why, size_t why_len);
 void hm_sensor_sim_destroy(hm_sensor_sim sim);
+/* The state dimension: 4 for the wheelset. */
+size_t hm_sensor_sim_dim(const hm_sensor_sim sim);
 
 /* Integrate to t_end_s (>= the current time), delivering every sample with time <= t_end_s not delivered yet.
  * HM_OK also when a callback stopped the run (then not to be resumed: samples of the last step are lost); the
  * integrator's error otherwise (the state and time stay where they were). */
 hm_status hm_sensor_sim_run(hm_sensor_sim sim, double t_end_s, const hm_sensor_sink *sink);
 
-/* The current time [s] and true state. */
+/* The current time [s] and true state (hm_sensor_sim_dim values). */
 double hm_sensor_sim_time(const hm_sensor_sim sim);
-void hm_sensor_sim_state(const hm_sensor_sim sim, double x[4]);
+void hm_sensor_sim_state(const hm_sensor_sim sim, double *x);
 /* Replace the state now (a disturbance, such as a lateral kick); HM_EINVAL if not finite. */
-hm_status hm_sensor_sim_set_state(hm_sensor_sim sim, const double x[4]);
+hm_status hm_sensor_sim_set_state(hm_sensor_sim sim, const double *x);
 /* The speed [km/h] of the profile at t. */
 double hm_sensor_sim_speed_kmh(const hm_sensor_sim sim, double t_s);
 /* The track's r.m.s. irregularity [m] (0 on a perfect track). */

@@ -43,6 +43,12 @@ typedef hm_status (*hm_system_rhs_fn)(const void *model, double speed_mps, const
 typedef hm_status (*hm_system_jac_fn)(const void *model, double speed_mps, const double *x, double *jac);
 /* df/dv [per m/s] at x. */
 typedef hm_status (*hm_system_dfdv_fn)(const void *model, double speed_mps, const double *x, double *dfdv);
+/* f(x; v) over a track whose lateral position under wheelset i is y_track_m[i] (the wheel-rail terms see y_i -
+ * y_track_i): the simulators' right-hand side. */
+typedef hm_status (*hm_system_track_fn)(const void *model, double speed_mps, const double *x, const double *y_track_m,
+                                        double *dxdt);
+
+#define HM_SYSTEM_MAX_WHEELSETS 4
 
 typedef struct {
   size_t dim;                    /* state dimension, 1..HM_SYSTEM_MAX_DIM */
@@ -58,7 +64,18 @@ typedef struct {
   size_t amp_state;              /* the state whose max |x| is a cycle's amplitude (the leading wheelset's y) */
   size_t phase_state;            /* its rate (x[amp_state]' = x[phase_state]): a cycle starts where it is 0 */
   int odd;                       /* 1 if f(-x) = -f(x) (lambda(y) even): symmetric cycles, half-period shooting */
+  hm_system_track_fn rhs_track;  /* the right-hand side over a track */
+  size_t n_wheelsets;            /* 1..HM_SYSTEM_MAX_WHEELSETS, leading first */
+  const double *wheelset_x_m;    /* their longitudinal positions [m], decreasing (the leading one first) */
 } hm_system;
+
+/* An accelerometer on a model: sum of weight[j] * dx[state[j]] [m/s^2] over velocity states (a lateral
+ * acceleration at a point of a body: y'' + x psi'' of its lateral and yaw states). */
+typedef struct {
+  size_t n_terms;    /* 1..4 */
+  size_t state[4];
+  double weight[4];  /* 1 for a lateral acceleration, the lever arm [m] for a yaw one */
+} hm_sensor_point;
 
 /* The spectrum at one speed. */
 typedef struct {
@@ -80,9 +97,11 @@ typedef struct {
 void hm_system_critical_options_default(hm_system_critical_options *opt);
 
 /* Every field present and consistent (dim and n_bodies in range, callbacks set, bodies in range, inertias finite and
- * >= 0 and at least one > 0, scales finite and > 0, amp_state and phase_state distinct states); HM_EINVAL
- * otherwise. */
+ * >= 0 and at least one > 0, scales finite and > 0, amp_state and phase_state distinct states, the wheelsets' count
+ * and positions); HM_EINVAL otherwise. */
 hm_status hm_system_validate(const hm_system *sys);
+/* 1 if the point's states are in range and its weights finite (n_terms 1..4). */
+int hm_sensor_point_valid(const hm_system *sys, const hm_sensor_point *point);
 
 /* The eigenvalues of df/dx at x = 0 and speed_mps in dgeev's order (re, im: dim each), and with vr != NULL its right
  * eigenvectors (column-major dim x dim, dgeev's packing: a pair's real and imaginary parts in columns k, k + 1). No
@@ -102,7 +121,7 @@ hm_status hm_system_critical_speed(const hm_system *sys, const hm_system_critica
  * y (state 0), phase dy/dt (state 1), scales 1 mm, 0.1 m/s, 1 mrad, 0.1 rad/s. */
 typedef struct {
   hm_model model; /* the vehicle and its coefficients; the speed is given per call */
-  double inertia[4], scale[4];
+  double inertia[4], scale[4], x_m[1];
   int body[4];
 } hm_wheelset_system;
 

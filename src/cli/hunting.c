@@ -211,6 +211,7 @@ static const cli_option simulate_opts[] = {
     {"speed-out", "FILE", "also write a sensor stream t_s,speed_kmh (at 10 Hz)"},
     {"accel-noise", "SIGMA", "white noise [m/s^2] added to --accel-out (default 0)"},
     {"linear", NULL, "linear model: constant conicity lambda(0), no flange force"},
+    {"sensor", "WHERE", "a bogie's or car's accelerometer: axlebox (the leading wheelset, default), frame, carbody"},
     {"rtol", "R", "relative tolerance of Dormand-Prince 5(4) (default 1e-9)"},
     {"atol", "A", "absolute tolerance (default 1e-12)"},
     VEHICLE_OPTIONS,
@@ -295,7 +296,35 @@ static int parse_profile(const char *s, double *t, double *v, size_t *n) {
   return 0;
 }
 
+/* A bogie's or car's run: the accelerometer where --sensor says (axlebox by default), --x0 the leading wheelset's. */
+static hm_status simulate_system(const cli_args *a, const cli_model *cm, const hm_sensor_sim_config *cfg,
+                                 const double *x_lead, hm_sensor_sim *sim, char *why, size_t len) {
+  const char *where = cli_value(a, "sensor") ? cli_value(a, "sensor") : "axlebox";
+  hm_sensor_point point;
+  hm_status st = cm->kind == HM_MODEL_CAR ? hm_car_sensor(&cm->car, where, &point)
+                                          : hm_bogie_sensor(&cm->bogie, where, &point);
+  if (st != HM_OK) {
+    snprintf(why, len, "--sensor: '%s' is not a place on a %s (axlebox, frame%s)", where,
+             hm_model_kind_name(cm->kind), cm->kind == HM_MODEL_CAR ? ", carbody" : "");
+    return st;
+  }
+  double x0[HM_SYSTEM_MAX_DIM] = {0.0};
+  for (int i = 0; i < 4; ++i) x0[i] = x_lead[i];
+  return hm_sensor_sim_create_system(&cm->sys, &point, cfg, x0, sim, why, len);
+}
+
 static int cmd_simulate(const cli_args *a) {
+  static cli_model cm; /* a bogie's or car's; its system points into it */
+  hm_model_kind kind;
+  if (cli_model_kind(a, &kind) || (kind != HM_MODEL_WHEELSET && cli_vehicle_model(a, kind, &cm))) return 1;
+  if (kind != HM_MODEL_WHEELSET && cli_has(a, "linear")) {
+    fprintf(stderr, "hunting simulate: --linear is for the wheelset model\n");
+    return 1;
+  }
+  if (kind == HM_MODEL_WHEELSET && cli_has(a, "sensor") && strcmp(cli_value(a, "sensor"), "axlebox") != 0) {
+    fprintf(stderr, "hunting simulate: a wheelset has only its axle box (--sensor axlebox)\n");
+    return 1;
+  }
   hm_vehicle veh, lin;
   double v_kmh = 0.0, x[4] = {0.001, 0.0, 0.0, 0.0}, t_end = 10.0, dt_out = 0.001, rtol = 1e-9, atol = 1e-12;
   double v_end = NAN, scale = 0.0, seed = 1.0, noise = 0.0;
@@ -304,7 +333,8 @@ static int cmd_simulate(const cli_args *a) {
   const char *profile = cli_value(a, "profile");
   if (profile && parse_profile(profile, prof_t, prof_v, &n_prof)) return 1;
   if (profile) v_kmh = prof_v[0];
-  if (cli_vehicle(a, &veh, NULL) || (!profile && cli_speed_option(a, &v_kmh)) || cli_number_list(a, "x0", x, 4) ||
+  if ((kind == HM_MODEL_WHEELSET && cli_vehicle(a, &veh, NULL)) || (!profile && cli_speed_option(a, &v_kmh)) ||
+      cli_number_list(a, "x0", x, 4) ||
       cli_number(a, "t", &t_end) || cli_number(a, "dt-out", &dt_out) || cli_number(a, "rtol", &rtol) ||
       cli_number(a, "atol", &atol) || cli_number(a, "v-end", &v_end) || cli_number(a, "irregularity", &scale) ||
       cli_number(a, "seed", &seed) || cli_number(a, "accel-noise", &noise))
@@ -337,7 +367,8 @@ static int cmd_simulate(const cli_args *a) {
   cfg.max_step_s = scale > 0.0 ? 2e-3 : 0.0;
   hm_sensor_sim sim = NULL;
   char why[160] = "";
-  hm_status st = hm_sensor_sim_create(&veh, &cfg, x, &sim, why, sizeof why);
+  hm_status st = kind == HM_MODEL_WHEELSET ? hm_sensor_sim_create(&veh, &cfg, x, &sim, why, sizeof why)
+                                           : simulate_system(a, &cm, &cfg, x, &sim, why, sizeof why);
   if (st != HM_OK) {
     fprintf(stderr, "hunting simulate: %s\n", why);
     return 1;
@@ -519,7 +550,10 @@ static const command commands[] = {
     {"simulate", "time integration of the nonlinear model to CSV", "--v KM/H [--x0 Y,DY,PSI,DPSI] [--t SECONDS] [options]",
      "Integrate the nonlinear model (Dormand-Prince 5(4), error control, dense output) and write CSV:\n"
      "t_s,y_m,dy_mps,psi_rad,dpsi_radps,accel_lat_mps2 (the lateral acceleration is dy'/dt of the model);\n"
-     "optionally on an irregular track along a speed ramp, with sensor streams for 'hunting estimate'.",
+     "optionally on an irregular track along a speed ramp, with sensor streams for 'hunting estimate'.\n"
+     "A bogie's or car's config: its leading wheelset's states in those columns, the acceleration at --sensor\n"
+     "(axlebox, frame: the frame over the leading axle, carbody: over the leading bogie), the wheelsets meeting\n"
+     "the track one after another at their spacing.",
      simulate_opts, cmd_simulate},
     {"lyapunov", "Lyapunov exponent spectrum of a trajectory", "--v KM/H [--linear] [options]",
      "Lyapunov exponent spectrum [1/s] of a trajectory (Benettin with QR re-orthonormalisation), by the\n"

@@ -57,6 +57,23 @@ static hm_status sys_dfdv(const void *model, double v, const double *x, double *
   return hm_bogie_dfdv((const hm_bogie_model *)model, v, x, dfdv);
 }
 
+static hm_status sys_rhs_track(const void *model, double v, const double *x, const double *yt, double *dx) {
+  return hm_bogie_rhs((const hm_bogie_model *)model, v, x, yt, dx);
+}
+
+hm_status hm_bogie_sensor(const hm_bogie_model *m, const char *where, hm_sensor_point *out) {
+  if (!m || !where || !out) return HM_EINVAL;
+  if (strcmp(where, "axlebox") == 0) {
+    *out = (hm_sensor_point){1, {1, 0, 0, 0}, {1.0, 0.0, 0.0, 0.0}};
+    return HM_OK;
+  }
+  if (strcmp(where, "frame") == 0 && !m->frame_held) {
+    *out = (hm_sensor_point){2, {9, 11, 0, 0}, {1.0, m->bogie.half_wheelbase_m, 0.0, 0.0}};
+    return HM_OK;
+  }
+  return HM_EINVAL;
+}
+
 hm_status hm_bogie_dfdv(const hm_bogie_model *m, double v, const double *x, double *dfdv) {
   const size_t n = m->frame_held ? HM_BOGIE_HELD_DIM : HM_BOGIE_DIM;
   const double iv2 = 1.0 / (v * v);
@@ -87,10 +104,12 @@ hm_status hm_bogie_model_init(hm_bogie_model *m, const hm_bogie *bogie, int fram
   memcpy(w.inertia, inertia, sizeof inertia);
   memcpy(w.scale, scale, sizeof scale);
   memcpy(w.body, body, sizeof body);
+  w.x_m[0] = bogie->half_wheelbase_m;
+  w.x_m[1] = -bogie->half_wheelbase_m;
   *m = w;
   *sys = (hm_system){m->frame_held ? HM_BOGIE_HELD_DIM : HM_BOGIE_DIM, sys_rhs, sys_jac, sys_dfdv, m, 2,
                      BOGIE_BODIES, m->body, m->inertia, m->scale, 0, 1,
-                     hm_conicity_is_even(&bogie->wheelset.conicity, 1e-12)};
+                     hm_conicity_is_even(&bogie->wheelset.conicity, 1e-12), sys_rhs_track, 2, m->x_m};
   return HM_OK;
 }
 

@@ -42,6 +42,19 @@ static hm_status sys_jac(const void *model, double v, const double *x, double *j
 static hm_status sys_dfdv(const void *model, double v, const double *x, double *dfdv) {
   return hm_car_dfdv((const hm_car_model *)model, v, x, dfdv);
 }
+static hm_status sys_rhs_track(const void *model, double v, const double *x, const double *yt, double *dx) {
+  return hm_car_rhs((const hm_car_model *)model, v, x, yt, dx);
+}
+
+hm_status hm_car_sensor(const hm_car_model *m, const char *where, hm_sensor_point *out) {
+  if (!m || !where || !out) return HM_EINVAL;
+  if (strcmp(where, "carbody") == 0) {
+    if (m->carbody_held) return HM_EINVAL;
+    *out = (hm_sensor_point){2, {YC + 1, YC + 3, 0, 0}, {1.0, m->car.half_bogie_distance_m, 0.0, 0.0}};
+    return HM_OK;
+  }
+  return hm_bogie_sensor(&m->bogie, where, out); /* the leading bogie's states come first */
+}
 
 hm_status hm_car_model_init(hm_car_model *m, const hm_car *car, int carbody_held, hm_system *sys) {
   if (!m || !car || !sys) return HM_EINVAL;
@@ -65,9 +78,11 @@ hm_status hm_car_model_init(hm_car_model *m, const hm_car *car, int carbody_held
     w.scale[YC + i] = i % 2 ? 0.1 : 1e-3;
     w.body[YC + i] = 2;
   }
+  const double a = car->half_bogie_distance_m, b = car->bogie.half_wheelbase_m;
+  w.x_m[0] = a + b, w.x_m[1] = a - b, w.x_m[2] = -a + b, w.x_m[3] = -a - b;
   *m = w;
   *sys = (hm_system){m->carbody_held ? HM_CAR_HELD_DIM : HM_CAR_DIM, sys_rhs, sys_jac, sys_dfdv, m, 3, CAR_BODIES,
-                     m->body, m->inertia, m->scale, 0, 1, bogie_sys.odd};
+                     m->body, m->inertia, m->scale, 0, 1, bogie_sys.odd, sys_rhs_track, 4, m->x_m};
   return HM_OK;
 }
 

@@ -36,7 +36,19 @@ hm_status hm_system_validate(const hm_system *sys) {
     if (!isfinite(sc) || !(sc > 0.0)) return HM_EINVAL;
     total += w;
   }
+  if (!sys->rhs_track || sys->n_wheelsets < 1 || sys->n_wheelsets > HM_SYSTEM_MAX_WHEELSETS || !sys->wheelset_x_m)
+    return HM_EINVAL;
+  for (size_t i = 0; i < sys->n_wheelsets; ++i)
+    if (!isfinite(sys->wheelset_x_m[i]) || (i > 0 && !(sys->wheelset_x_m[i] < sys->wheelset_x_m[i - 1])))
+      return HM_EINVAL;
   return total > 0.0 ? HM_OK : HM_EINVAL;
+}
+
+int hm_sensor_point_valid(const hm_system *sys, const hm_sensor_point *p) {
+  if (!sys || !p || p->n_terms < 1 || p->n_terms > 4) return 0;
+  for (size_t j = 0; j < p->n_terms; ++j)
+    if (p->state[j] >= sys->dim || !isfinite(p->weight[j])) return 0;
+  return 1;
 }
 
 /* Order: decreasing real part, then decreasing imaginary part; perm follows (insertion sort). */
@@ -190,6 +202,16 @@ static hm_status ws_dfdv(const void *model, double v, const double *x, double *d
   return isfinite(dfdv[1]) && isfinite(dfdv[3]) ? HM_OK : HM_ENONFINITE;
 }
 
+/* The wheel-rail terms on y - y_track, the springs on y (as excitation.c's). */
+static hm_status ws_rhs_track(const void *model, double v, const double *x, const double *yt, double *dx) {
+  const hm_model *m = &((const hm_wheelset_system *)model)->model;
+  const double xr[4] = {x[0] - yt[0], x[1], x[2], x[3]};
+  hm_status st = hm_model_rhs_at(m, v, xr, dx);
+  if (st != HM_OK) return st;
+  dx[1] -= m->coef.k_lat_s2 * yt[0];
+  return isfinite(dx[1]) ? HM_OK : HM_ENONFINITE;
+}
+
 hm_status hm_wheelset_system_init(hm_wheelset_system *ws, const hm_vehicle *veh, hm_system *sys) {
   if (!ws || !veh || !sys) return HM_EINVAL;
   hm_wheelset_system w;
@@ -200,8 +222,9 @@ hm_status hm_wheelset_system_init(hm_wheelset_system *ws, const hm_vehicle *veh,
   memcpy(w.inertia, inertia, sizeof inertia);
   memcpy(w.scale, scale, sizeof scale);
   for (int i = 0; i < 4; ++i) w.body[i] = 0;
+  w.x_m[0] = 0.0;
   *ws = w;
   *sys = (hm_system){4, ws_rhs, ws_jac, ws_dfdv, ws, 1, WHEELSET_BODIES, ws->body, ws->inertia, ws->scale, 0, 1,
-                     hm_conicity_is_even(&veh->conicity, 1e-12)};
+                     hm_conicity_is_even(&veh->conicity, 1e-12), ws_rhs_track, 1, ws->x_m};
   return HM_OK;
 }

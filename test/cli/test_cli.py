@@ -1076,6 +1076,39 @@ def test_car_critical_and_cycles():
     close(fam["hopf"]["v_kmh"], out["v_crit_kmh"], 1e-6, "the car family's Hopf speed")
 
 
+def test_bogie_and_car_simulate():
+    """`hunting simulate` on a bogie and a car: a frame or carbody accelerometer's stream that `hunting estimate`
+    reads; on a perfect track from a kick below the critical speed the leading wheelset's motion decays at the rate
+    `hunting eig` gives (the least-damped mode's real part, fitted to the envelope); a place not on the model is
+    refused."""
+    bogie = os.path.join(SRC, "config", "bogie_default.yaml")
+    car = os.path.join(SRC, "config", "car_default.yaml")
+    with tempfile.TemporaryDirectory() as d:
+        acc, spd, st = (os.path.join(d, n) for n in ("a.csv", "s.csv", "st.csv"))
+        run("simulate", "--config", bogie, "--v", "450", "--t", "30", "--irregularity", "0.3", "--sensor", "frame",
+            "--dt-out", "0.002", "--accel-noise", "0.05", "--accel-out", acc, "--speed-out", spd, "--out", st)
+        lines = estimate_lines(acc, spd, 30)
+        assert lines and lines[-1]["accel_samples"] == 15001, lines[-1]["accel_samples"]
+        # 530 km/h, 11 km/h below the critical speed: the least-damped mode well apart from the others
+        run("simulate", "--config", bogie, "--v", "530", "--t", "12", "--x0", "0.0001,0,0,0", "--dt-out", "0.001",
+            "--out", st)
+        rows = list(csv.DictReader(open(st)))
+        eig = run_json("eig", "--config", bogie, "--v", "530")
+        sigma = max(e[0] for e in eig["eigenvalues"] if e[1] > 1.0)  # the least-damped oscillatory mode
+        # the envelope: max |y1| over 1 s blocks from 3 s on (the faster modes gone), its log-linear slope
+        t_blocks, logs = [], []
+        for k in range(3, 12):
+            seg = [abs(float(r["y_m"])) for r in rows if k < float(r["t_s"]) <= k + 1]
+            t_blocks.append(k + 0.5)
+            logs.append(math.log(max(seg)))
+        n = len(t_blocks)
+        mt, ml = sum(t_blocks) / n, sum(logs) / n
+        slope = sum((t - mt) * (l - ml) for t, l in zip(t_blocks, logs)) / sum((t - mt) ** 2 for t in t_blocks)
+        close(slope, sigma, 0.03 * abs(sigma), "the kick's decay against the least-damped eigenvalue")
+        p = run("simulate", "--config", car, "--v", "300", "--t", "1", "--sensor", "roof", ok=False)
+        assert p.returncode != 0 and "'roof' is not a place on a car" in p.stderr, p.stderr
+
+
 def main():
     global failures
     tests = [(n, f) for n, f in globals().items() if n.startswith("test_") and callable(f)]

@@ -5,6 +5,8 @@
 #include <string.h>
 
 #include "hm_test.h"
+#include "hunting_monitor/bogie.h"
+#include "hunting_monitor/linear.h"
 #include "hunting_monitor/sensor_sim.h"
 
 typedef struct {
@@ -218,10 +220,122 @@ static void refused_settings(void) {
   HM_CHECK(s == NULL, "output written on failure");
 }
 
+/* A model's run (hm_sensor_sim_create_system). The wheelset as a system gives the wheelset's run bit for bit; a bogie
+ * with its frame held (two independent wheelsets) shows the track under the trailing wheelset 2b / v after the
+ * leading one: once the start has died away, y2(t) = y1(t - 2b / v); a frame accelerometer reads yf'' + b psif'' of
+ * the bogie's own equations. */
+typedef struct {
+  size_t n, cap, dim;
+  double *x;     /* n x dim states */
+  double *accel; /* the true acceleration */
+} state_rec;
+
+static int on_state(void *ctx, double t, double measured, double true_accel, const double *x) {
+  (void)t, (void)measured;
+  state_rec *r = (state_rec *)ctx;
+  if (r->n < r->cap) {
+    memcpy(r->x + r->dim * r->n, x, r->dim * sizeof(double));
+    r->accel[r->n] = true_accel;
+  }
+  ++r->n;
+  return 0;
+}
+
+static void run_states(hm_sensor_sim sim, double t_end, state_rec *r) {
+  const hm_sensor_sink sink = {on_state, NULL, r};
+  HM_CHECK(hm_sensor_sim_run(sim, t_end, &sink) == HM_OK, "run");
+}
+
+static void models_on_a_track(void) {
+  hm_sensor_sim_config c;
+  hm_sensor_sim_config_default(&c);
+  c.v_start_kmh = c.v_end_kmh = 300.0;
+  c.irregularity_scale = 1.0;
+  c.accel_rate_hz = 1000.0;
+  c.accel_noise_mps2 = 0.0;
+  enum { N = 20001 };
+  /* the wheelset both ways */
+  hm_vehicle veh;
+  hm_vehicle_default(&veh);
+  hm_wheelset_system ws;
+  hm_system sys;
+  HM_CHECK(hm_wheelset_system_init(&ws, &veh, &sys) == HM_OK, "wheelset system");
+  const hm_sensor_point axle = {1, {1, 0, 0, 0}, {1.0, 0.0, 0.0, 0.0}};
+  state_rec a = {0, N, 4, calloc(N * 4, sizeof(double)), calloc(N, sizeof(double))};
+  state_rec b = {0, N, 4, calloc(N * 4, sizeof(double)), calloc(N, sizeof(double))};
+  hm_sensor_sim sa = NULL, sb = NULL;
+  HM_CHECK(hm_sensor_sim_create(&veh, &c, NULL, &sa, NULL, 0) == HM_OK, "wheelset run");
+  HM_CHECK(hm_sensor_sim_create_system(&sys, &axle, &c, NULL, &sb, NULL, 0) == HM_OK, "system run");
+  if (sa && sb) {
+    run_states(sa, 5.0, &a);
+    run_states(sb, 5.0, &b);
+    HM_CHECK(a.n == b.n && a.n == 5001, "samples %zu, %zu", a.n, b.n);
+    HM_CHECK(memcmp(a.x, b.x, 4 * a.n * sizeof(double)) == 0 && memcmp(a.accel, b.accel, a.n * sizeof(double)) == 0,
+             "the wheelset as a system is the wheelset, bit for bit");
+  }
+  hm_sensor_sim_destroy(sa);
+  hm_sensor_sim_destroy(sb);
+  /* the held bogie: the trailing wheelset repeats the leading one 2b / v later */
+  hm_bogie bogie;
+  hm_bogie_default(&bogie);
+  hm_bogie_model held;
+  HM_CHECK(hm_bogie_model_init(&held, &bogie, 1, &sys) == HM_OK, "held bogie");
+  state_rec h = {0, N, HM_BOGIE_HELD_DIM, calloc(N * HM_BOGIE_HELD_DIM, sizeof(double)), calloc(N, sizeof(double))};
+  hm_sensor_sim sh = NULL;
+  HM_CHECK(hm_sensor_sim_create_system(&sys, &axle, &c, NULL, &sh, NULL, 0) == HM_OK && sh, "held run");
+  if (sh) {
+    run_states(sh, 20.0, &h);
+    const double delay_s = 2.0 * bogie.half_wheelbase_m / hm_mps_from_kmh(300.0); /* 0.03 s: 30 samples */
+    const size_t lag = (size_t)lround(delay_s * c.accel_rate_hz);
+    double worst = 0.0, size = 0.0;
+    for (size_t k = 10000; k < h.n && k < N; ++k) {
+      const double y1 = h.x[HM_BOGIE_HELD_DIM * (k - lag)], y2 = h.x[HM_BOGIE_HELD_DIM * k + 4];
+      worst = fmax(worst, fabs(y2 - y1));
+      size = fmax(size, fabs(y1));
+    }
+    printf("  held bogie: |y2(t) - y1(t - %.3f s)| <= %.3g m over 10-20 s, |y1| up to %.3g m\n", delay_s, worst, size);
+    HM_CHECK(size > 1e-4 && worst < 1e-6 * size, "the trailing wheelset meets the track 2b / v later");
+  }
+  hm_sensor_sim_destroy(sh);
+  /* a frame accelerometer: yf'' + b psif'' of the bogie's right-hand side at the sampled state */
+  hm_bogie_model free_frame;
+  HM_CHECK(hm_bogie_model_init(&free_frame, &bogie, 0, &sys) == HM_OK, "bogie");
+  hm_sensor_point frame;
+  HM_CHECK(hm_bogie_sensor(&free_frame, "frame", &frame) == HM_OK, "frame point");
+  HM_CHECK(hm_bogie_sensor(&held, "frame", &frame) == HM_EINVAL, "no frame point on a held frame");
+  HM_CHECK(hm_bogie_sensor(&free_frame, "frame", &frame) == HM_OK, "frame point");
+  c.irregularity_scale = 0.0; /* on a perfect track the right-hand side is the bogie's without track input */
+  const double x0[HM_BOGIE_DIM] = {0.003, 0.0, 0.0005, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0};
+  state_rec f = {0, N, HM_BOGIE_DIM, calloc(N * HM_BOGIE_DIM, sizeof(double)), calloc(N, sizeof(double))};
+  hm_sensor_sim sf = NULL;
+  HM_CHECK(hm_sensor_sim_create_system(&sys, &frame, &c, x0, &sf, NULL, 0) == HM_OK && sf, "frame run");
+  if (sf) {
+    run_states(sf, 2.0, &f);
+    double worst = 0.0, size = 0.0;
+    for (size_t k = 0; k < f.n && k < N; ++k) {
+      double dx[HM_BOGIE_DIM];
+      hm_bogie_rhs(&free_frame, hm_mps_from_kmh(300.0), f.x + HM_BOGIE_DIM * k, NULL, dx);
+      const double ref = dx[9] + bogie.half_wheelbase_m * dx[11];
+      worst = fmax(worst, fabs(f.accel[k] - ref));
+      size = fmax(size, fabs(ref));
+    }
+    HM_CHECK(size > 0.01 && worst <= 1e-12 * size, "frame acceleration yf'' + b psif'' (off by %.3g of %.3g)", worst,
+             size);
+  }
+  hm_sensor_sim_destroy(sf);
+  const hm_sensor_point off = {1, {40, 0, 0, 0}, {1.0, 0.0, 0.0, 0.0}};
+  hm_sensor_sim bad = NULL;
+  char why[120] = "";
+  HM_CHECK(hm_sensor_sim_create_system(&sys, &off, &c, NULL, &bad, why, sizeof why) == HM_EINVAL && !bad &&
+               strstr(why, "not on the model"), "a sensor off the model: %s", why);
+  free(a.x), free(a.accel), free(b.x), free(b.accel), free(h.x), free(h.accel), free(f.x), free(f.accel);
+}
+
 int main(void) {
   HM_RUN(sample_times_and_speed_profile);
   HM_RUN(acceleration_and_noise);
   HM_RUN(reproducible_disturbed_and_stoppable);
   HM_RUN(refused_settings);
+  HM_RUN(models_on_a_track);
   HM_TEST_EXIT();
 }
