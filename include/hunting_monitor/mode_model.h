@@ -15,7 +15,12 @@
  * chi2 as inversion.h's. For the wheelset it gives inversion.h's numbers (test_mode_model: to 1e-7).
  * The Hopf speed at a conicity: hm_system_critical_speed (100-1500 km/h, 5 km/h scan, bisection to 1e-6 km/h), the
  * first crossing of any mode, and whose mode that is.
- * One model is used by one thread at a time (it holds its parameters and system); create allocates, nothing after.
+ * The Hopf curve for the monitor (hm_mode_model_hopf_kmh): the exact speed at HM_MODE_MODEL_GRID conicities spaced
+ * geometrically over [HM_MODE_MODEL_LAMBDA_MIN, HM_MODE_MODEL_LAMBDA_MAX], each computed when first needed, and
+ * 1/V^2 interpolated linearly in the conicity between them (exact for the wheelset, whose Hurwitz condition is affine
+ * in lambda; for the bogie within 0.05 km/h where one mode stays critical, test_mode_model).
+ * One model is used by one thread at a time (it holds its parameters, system and curve); create allocates, nothing
+ * after.
  */
 #ifndef HUNTING_MONITOR_MODE_MODEL_H
 #define HUNTING_MONITOR_MODE_MODEL_H
@@ -32,6 +37,9 @@ extern "C" {
 #endif
 
 #define HM_MODE_MODEL_SCAN 40
+#define HM_MODE_MODEL_GRID 160
+#define HM_MODE_MODEL_LAMBDA_MIN 0.01
+#define HM_MODE_MODEL_LAMBDA_MAX 2.0
 
 typedef struct hm_mode_model_s *hm_mode_model;
 
@@ -41,7 +49,22 @@ hm_status hm_mode_model_create_bogie(const hm_bogie *bogie, hm_mode_model *out);
 hm_status hm_mode_model_create_car(const hm_car *car, hm_mode_model *out);
 void hm_mode_model_destroy(hm_mode_model m);
 
+/* Any of the three from a kind and the car's parameters (the bogie's are car->bogie, the wheelset's
+ * car->bogie.wheelset). */
+hm_status hm_mode_model_create(hm_model_kind kind, const hm_car *params, hm_mode_model *out);
+
 hm_model_kind hm_mode_model_kind(const hm_mode_model m);
+/* The parameters the model was made with (the conicity as given at creation). */
+void hm_mode_model_params(const hm_mode_model m, hm_car *params);
+
+/* The least-damped oscillatory root at conicity and speed (the largest real part with a positive imaginary part):
+ * the mode that goes unstable first. */
+hm_status hm_mode_model_least_damped(hm_mode_model m, double conicity, double speed_kmh, double *sigma_1_s,
+                                     double *omega_rad_s);
+
+/* The Hopf speed at a conicity from the curve above [km/h]; HM_LINEAR_NO_HOPF_KMH (linear.h) where there is none
+ * in 100-1500 km/h or the conicity is outside the grid's range; computes grid points on first need. */
+double hm_mode_model_hopf_kmh(hm_mode_model m, double conicity);
 
 /* The hunting root at conicity and speed nearest the reference mode (errors e_sigma [1/s], e_f [Hz] > 0 weigh the
  * distance): its decay rate [1/s] and frequency [Hz]. HM_ENOCRIT if no oscillatory mode. */

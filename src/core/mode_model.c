@@ -17,6 +17,8 @@ struct hm_mode_model_s {
   hm_car_model car;
   hm_system sys;
   double conicity;       /* the conicity the system holds (NAN: none yet) */
+  hm_car given;          /* the parameters as created */
+  double grid_hopf_kmh[HM_MODE_MODEL_GRID]; /* the Hopf curve: NAN not computed yet, +inf none */
 };
 
 static hm_status set_conicity(hm_mode_model m, double conicity) {
@@ -40,7 +42,9 @@ static hm_status create(hm_model_kind kind, const hm_car *params, hm_mode_model 
   if (!m) return HM_ENOMEM;
   m->kind = kind;
   m->params = *params;
+  m->given = *params;
   m->conicity = NAN;
+  for (size_t i = 0; i < HM_MODE_MODEL_GRID; ++i) m->grid_hopf_kmh[i] = NAN;
   double l0;
   hm_conicity_eval(&params->bogie.wheelset.conicity, 0.0, &l0, NULL);
   hm_status st = set_conicity(m, l0);
@@ -81,7 +85,21 @@ hm_status hm_mode_model_create_car(const hm_car *car, hm_mode_model *out) {
 
 void hm_mode_model_destroy(hm_mode_model m) { free(m); }
 
+hm_status hm_mode_model_create(hm_model_kind kind, const hm_car *params, hm_mode_model *out) {
+  if (!params) return HM_EINVAL;
+  switch (kind) {
+    case HM_MODEL_WHEELSET: return hm_mode_model_create_wheelset(&params->bogie.wheelset, out);
+    case HM_MODEL_BOGIE: return hm_mode_model_create_bogie(&params->bogie, out);
+    case HM_MODEL_CAR: return hm_mode_model_create_car(params, out);
+  }
+  return HM_EINVAL;
+}
+
 hm_model_kind hm_mode_model_kind(const hm_mode_model m) { return m->kind; }
+
+void hm_mode_model_params(const hm_mode_model m, hm_car *params) {
+  if (m && params) *params = m->given;
+}
 
 /* The root with im > 0 nearest (sigma_ref, w_ref) in the metric of (e_sigma, e_w). */
 static hm_status nearest_root(hm_mode_model m, double conicity, double v_kmh, double sigma_ref, double e_sigma,
@@ -102,6 +120,51 @@ static hm_status nearest_root(hm_mode_model m, double conicity, double v_kmh, do
   *sigma = re[k];
   *w = im[k];
   return HM_OK;
+}
+
+hm_status hm_mode_model_least_damped(hm_mode_model m, double conicity, double speed_kmh, double *sigma_1_s,
+                                     double *omega_rad_s) {
+  if (!m || !sigma_1_s || !omega_rad_s || !(speed_kmh > 0.0) || !isfinite(speed_kmh) || !isfinite(conicity) ||
+      conicity < 0.0)
+    return HM_EDOMAIN;
+  hm_status st = set_conicity(m, conicity);
+  if (st != HM_OK) return st;
+  double re[NMAX], im[NMAX];
+  if ((st = hm_system_eig(&m->sys, hm_mps_from_kmh(speed_kmh), re, im, NULL)) != HM_OK) return st;
+  size_t k = m->sys.dim;
+  for (size_t i = 0; i < m->sys.dim; ++i)
+    if (im[i] > 0.0 && (k == m->sys.dim || re[i] > re[k])) k = i;
+  if (k == m->sys.dim) return HM_ENOCRIT;
+  *sigma_1_s = re[k];
+  *omega_rad_s = im[k];
+  return HM_OK;
+}
+
+static double grid_conicity(size_t i) {
+  return HM_MODE_MODEL_LAMBDA_MIN *
+         pow(HM_MODE_MODEL_LAMBDA_MAX / HM_MODE_MODEL_LAMBDA_MIN, (double)i / (double)(HM_MODE_MODEL_GRID - 1));
+}
+
+/* The curve's value at grid point i (computed now if not yet): the Hopf speed, +inf where none. */
+static double grid_hopf(hm_mode_model m, size_t i) {
+  if (isnan(m->grid_hopf_kmh[i])) {
+    double v;
+    m->grid_hopf_kmh[i] = hm_mode_model_hopf(m, grid_conicity(i), &v, NULL, NULL) == HM_OK ? v : INFINITY;
+  }
+  return m->grid_hopf_kmh[i];
+}
+
+double hm_mode_model_hopf_kmh(hm_mode_model m, double conicity) {
+  if (!m || !(conicity >= HM_MODE_MODEL_LAMBDA_MIN && conicity <= HM_MODE_MODEL_LAMBDA_MAX))
+    return HM_LINEAR_NO_HOPF_KMH;
+  const double u = log(conicity / HM_MODE_MODEL_LAMBDA_MIN) / log(HM_MODE_MODEL_LAMBDA_MAX / HM_MODE_MODEL_LAMBDA_MIN);
+  size_t i = (size_t)(u * (double)(HM_MODE_MODEL_GRID - 1));
+  if (i >= HM_MODE_MODEL_GRID - 1) i = HM_MODE_MODEL_GRID - 2;
+  const double v0 = grid_hopf(m, i), v1 = grid_hopf(m, i + 1);
+  if (!isfinite(v0) || !isfinite(v1)) return HM_LINEAR_NO_HOPF_KMH;
+  const double l0 = grid_conicity(i), l1 = grid_conicity(i + 1), f = (conicity - l0) / (l1 - l0);
+  const double q = (1.0 - f) / (v0 * v0) + f / (v1 * v1); /* 1/V^2 linear in the conicity */
+  return fmin(1.0 / sqrt(q), HM_LINEAR_NO_HOPF_KMH);
 }
 
 static int inputs_ok(double v_kmh, double e_sigma, double e_f) {

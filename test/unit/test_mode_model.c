@@ -85,6 +85,39 @@ static void bogie_and_car_find_their_own_conicity(void) {
   }
 }
 
+/* The Hopf curve for the monitor: exact (the closed form) for the wheelset at any conicity, and within 0.05 km/h
+ * of the exact critical speed for the bogie where its wheelsets' mode stays the critical one (0.05-0.25). */
+static void hopf_curve(void) {
+  hm_vehicle veh;
+  hm_vehicle_default(&veh);
+  hm_bogie b;
+  hm_bogie_default(&b);
+  hm_mode_model w = NULL, m = NULL;
+  HM_CHECK(hm_mode_model_create_wheelset(&veh, &w) == HM_OK && hm_mode_model_create_bogie(&b, &m) == HM_OK, "create");
+  if (!w || !m) return;
+  double worst_w = 0.0, worst_b = 0.0;
+  for (double l = 0.05; l <= 0.25; l *= 1.037) {
+    worst_w = fmax(worst_w, fabs(hm_mode_model_hopf_kmh(w, l) - hm_linear_hopf_kmh(&veh, l)));
+    double v = 0.0;
+    HM_CHECK(hm_mode_model_hopf(m, l, &v, NULL, NULL) == HM_OK, "exact");
+    worst_b = fmax(worst_b, fabs(hm_mode_model_hopf_kmh(m, l) - v));
+  }
+  printf("  the curve off the exact Hopf speed by at most %.2g km/h (wheelset), %.3f km/h (bogie) over 0.05-0.25\n",
+         worst_w, worst_b);
+  HM_CHECK(worst_w < 1e-6, "the wheelset's curve is exact");
+  HM_CHECK(worst_b < 0.05, "the bogie's curve within 0.05 km/h");
+  HM_CHECK(hm_mode_model_hopf_kmh(m, 0.005) == HM_LINEAR_NO_HOPF_KMH, "below the grid: none");
+  double s = 0.0, om = 0.0, s_l = 0.0, om_l = 0.0;
+  hm_linear_coef coef;
+  hm_linear_coef_from_vehicle(&veh, &coef);
+  HM_CHECK(hm_mode_model_least_damped(w, 0.16, 430.0, &s, &om) == HM_OK &&
+               hm_hunting_root(&coef, 430.0, 0.16, &s_l, &om_l) == HM_OK, "least damped");
+  HM_CHECK_DELTA(s, s_l, 1e-9, "least-damped root as inversion.h's hunting root");
+  HM_CHECK_DELTA(om, om_l, 1e-9, "its frequency");
+  hm_mode_model_destroy(w);
+  hm_mode_model_destroy(m);
+}
+
 static void bad_input(void) {
   hm_vehicle veh;
   hm_vehicle_default(&veh);
@@ -109,6 +142,7 @@ static void bad_input(void) {
 int main(void) {
   HM_RUN(wheelset_as_inversion_h);
   HM_RUN(bogie_and_car_find_their_own_conicity);
+  HM_RUN(hopf_curve);
   HM_RUN(bad_input);
   HM_TEST_EXIT();
 }
