@@ -326,6 +326,10 @@ hm_status hm_alarm_set_config(hm_alarm alarm, const hm_alarm_config *cfg, const 
  * level only from an axle box; from a bogie frame the model-free one carries it with the prior (a wheelset model does
  * not hold the frame's modes: a frame sensor read -6.3 1/s where the bogie's least damped mode was -0.98, issue #26). */
 void hm_alarm_set_measurement_point(hm_alarm alarm, hm_measurement_point point);
+/* Hopf speeds from a bogie's or car's model (mode_model.h's curve) instead of the wheelset's closed form, the prior's
+ * recomputed; with such a model a bogie-frame sensor's model-based interval counts (the model holds the frame).
+ * Borrowed; NULL returns to the wheelset. */
+hm_status hm_alarm_set_model(hm_alarm alarm, hm_mode_model model);
 /* The prior's conicity range in use (resolved for the vehicle: alarm_config's conicity_prior_low/high or the fallback
  * -+ HM_ALARM_PRIOR_HALFWIDTH). */
 void hm_alarm_prior(const hm_alarm alarm, double *conicity_low, double *conicity_high);

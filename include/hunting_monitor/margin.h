@@ -78,6 +78,7 @@
 
 #include "hunting_monitor/inversion.h"
 #include "hunting_monitor/modal.h"
+#include "hunting_monitor/mode_model.h"
 #include "hunting_monitor/model.h"
 #include "hunting_monitor/status.h"
 
@@ -206,6 +207,10 @@ void hm_margin_read(const hm_margin m, double now_s, hm_margin_estimate *out);
 /* The closed-form Hopf speed [km/h] of the vehicle at a conicity; HM_TABLE_MAX_SPEED_KMH-like large value (1e4)
  * when the linear model is stable at every speed there. */
 double hm_margin_hopf_kmh(const hm_margin m, double conicity);
+/* Read the modes with a bogie's or car's model instead of the wheelset's closed forms (issue #28): its conicity from
+ * the mode, its least-damped root and its Hopf curve (mode_model.h). Borrowed: the caller keeps model alive; NULL
+ * returns to the wheelset. */
+void hm_margin_set_model(hm_margin m, hm_mode_model model);
 
 /* What the margin has learned, as plain data whose times are ages before a "now" [s] (state.h keeps it through a
  * restart, onto any time line): the windows held within memory_s, oldest first (the provisional one among them as

@@ -40,6 +40,7 @@ extern "C" {
 #define HM_MODE_MODEL_GRID 160
 #define HM_MODE_MODEL_LAMBDA_MIN 0.01
 #define HM_MODE_MODEL_LAMBDA_MAX 2.0
+#define HM_MODE_MODEL_CURVE_ERR_KMH 0.05 /* the curve's stated error against the exact Hopf speed (test_mode_model) */
 
 typedef struct hm_mode_model_s *hm_mode_model;
 

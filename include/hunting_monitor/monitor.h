@@ -94,6 +94,14 @@ hm_status hm_monitor_create(const hm_monitor_config *cfg, const hm_vehicle *veh,
 /* The same, a table to compute being computed through pfor(runner, ...) (tables.h; e.g. on every processor). */
 hm_status hm_monitor_create_parallel(const hm_monitor_config *cfg, const hm_vehicle *veh, hm_table table,
                                      hm_parallel_for_fn pfor, void *runner, hm_monitor *out, char *why, size_t why_len);
+/* A monitor of a bogie or a car (issue #28): its identified modes read, and its Hopf speeds and boundaries taken, by
+ * that model (mode_model.h, a table of its families: hm_table_build_model, or table checked against it); with
+ * HM_MODEL_WHEELSET exactly hm_monitor_create_parallel with params->bogie.wheelset. The monitor's vehicle
+ * (hm_monitor_vehicle) is the wheelsets'. Takes table in every case. */
+hm_status hm_monitor_create_model(const hm_monitor_config *cfg, hm_model_kind kind, const hm_car *params,
+                                  hm_table table, hm_parallel_for_fn pfor, void *runner, hm_monitor *out, char *why,
+                                  size_t why_len);
+hm_model_kind hm_monitor_model_kind(const hm_monitor m);
 void hm_monitor_destroy(hm_monitor m);
 /* Forget the stream (the time line restarted, by an unknown step): estimator, identification, the margin's windows
  * (their times are on the old line) and the alarm's hold; a held ALARM stays held with its hunted-at speed (a latch

@@ -27,6 +27,7 @@
 
 #include <stddef.h>
 
+#include "hunting_monitor/mode_model.h"
 #include "hunting_monitor/model.h"
 #include "hunting_monitor/status.h"
 
@@ -64,6 +65,12 @@ typedef void (*hm_parallel_for_fn)(void *runner, size_t n, hm_job_fn job, void *
 hm_status hm_table_build(const hm_vehicle *veh, const hm_table_spec *spec, hm_table *out);
 hm_status hm_table_build_parallel(const hm_vehicle *veh, const hm_table_spec *spec, hm_parallel_for_fn pfor,
                                   void *runner, hm_table *out);
+/* The same for a bogie's or car's model (kind HM_MODEL_BOGIE or HM_MODEL_CAR; its wheelsets' conicity shifted):
+ * its critical speed by eigenvalues and its families by system_cycles.h (about 0.25 s each for the bogie); the file's
+ * l1 is then only its sign (+1 subcritical: the family starts towards lower speeds, -1 supercritical) and kx_mn_m,
+ * ky_mn_m its wheelsets' primary stiffnesses. HM_EINVAL for the wheelset (hm_table_build). */
+hm_status hm_table_build_model(hm_model_kind kind, const hm_car *params, const hm_table_spec *spec,
+                               hm_parallel_for_fn pfor, void *runner, hm_table *out);
 
 /* Serialise into buf (len bytes); *needed gets the full size including the terminating NUL. HM_EINVAL if
  * len is too small (then call again with *needed bytes). */
@@ -117,6 +124,8 @@ void hm_table_vehicle(const hm_table t, double *kx_mn_m, double *ky_mn_m);
  * the reason in why otherwise (a table of another vehicle, or a corrupt one, must not be used). */
 #define HM_TABLE_CHECK_TOL_KMH 0.01 /* tables are written with 10 significant digits: 1e-7 km/h of rounding */
 hm_status hm_table_check_vehicle(const hm_table t, const hm_vehicle *veh, double tol_kmh, char *why, size_t why_len);
+/* The same against a bogie's or car's model: every curve's Hopf speed within tol_kmh of the model's exact one. */
+hm_status hm_table_check_model(const hm_table t, hm_mode_model model, double tol_kmh, char *why, size_t why_len);
 
 /* The interpolation error to expect at a conicity: the table's measured errors (at the midpoints of its original
  * grid step h0, where linear interpolation errs most) scaled by 4 d (h - d) / h0^2, d the distance to the curve

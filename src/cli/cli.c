@@ -206,7 +206,10 @@ int cli_vehicle_model(const cli_args *a, hm_model_kind kind, cli_model *out) {
     if (st == HM_OK) st = hm_bogie_model_init(&out->bogie_held, &car.bogie, 1, &out->held);
     out->held_name = "frame_held_v_crit_kmh";
   }
-  if (st != HM_OK) return cli_fail_status(hm_model_kind_name(kind), st);
+  if (st != HM_OK) {
+    fprintf(stderr, "hunting: %s: %s\n", hm_model_kind_name(kind), hm_status_str(st));
+    return 1;
+  }
   return 0;
 }
 

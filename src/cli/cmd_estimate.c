@@ -357,10 +357,25 @@ static void restore_state(const char *path, hm_monitor mon, double t0, hm_state_
 }
 
 int cmd_estimate(const cli_args *a) {
+  static cli_model cm; /* a bogie's or car's */
   hm_vehicle veh;
+  hm_model_kind kind;
+  hm_car params;
   double every = 0.1, v_const = NAN;
   const char *accel_path = cli_value(a, "accel"), *speed_path = cli_value(a, "speed");
-  if (cli_vehicle(a, &veh, NULL) || cli_number(a, "every", &every) || cli_number(a, "v", &v_const)) return 1;
+  if (cli_model_kind(a, &kind)) return 1;
+  if (kind == HM_MODEL_WHEELSET ? cli_vehicle(a, &veh, NULL) : cli_vehicle_model(a, kind, &cm)) return 1;
+  hm_car_default(&params);
+  if (kind == HM_MODEL_WHEELSET) params.bogie.wheelset = veh;
+  else if (kind == HM_MODEL_BOGIE) params.bogie = cm.bogie.bogie;
+  else params = cm.car.car;
+  veh = params.bogie.wheelset;
+  if (kind != HM_MODEL_WHEELSET && (cli_has(a, "state-in") || cli_has(a, "state-out"))) {
+    fprintf(stderr, "hunting estimate: --state-in and --state-out take the wheelset model (not yet a %s)\n",
+            hm_model_kind_name(kind));
+    return 1;
+  }
+  if (cli_number(a, "every", &every) || cli_number(a, "v", &v_const)) return 1;
   if (!accel_path || (!speed_path) == !cli_has(a, "v") || !(every > 0.0)) {
     fprintf(stderr, "hunting estimate: need --accel FILE and exactly one of --speed FILE or --v KM/H; --every > 0\n");
     return 1;
@@ -419,8 +434,8 @@ int cmd_estimate(const cli_args *a) {
   if (rc == 0) {
     char why[256] = "";
     hm_threads threads = {0}; /* a table to compute is computed on every processor */
-    const hm_status st =
-        hm_monitor_create_parallel(&cfg, &veh, table, hm_threads_parallel_for, &threads, &run.mon, why, sizeof why);
+    const hm_status st = hm_monitor_create_model(&cfg, kind, &params, table, hm_threads_parallel_for, &threads,
+                                                 &run.mon, why, sizeof why);
     if (st != HM_OK) {
       const int of_table = cli_value(a, "table") && strstr(why, "table") != NULL;
       fprintf(stderr, "hunting estimate: %s%s%s\n", of_table ? cli_value(a, "table") : "",

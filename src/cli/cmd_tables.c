@@ -21,12 +21,16 @@ const cli_option tables_opts[] = {
     {NULL, NULL, NULL}};
 
 int cmd_tables(const cli_args *a) {
+  static cli_model cm; /* a bogie's or car's */
   hm_vehicle veh;
+  hm_model_kind kind;
   hm_table_spec spec;
   hm_table_spec_default(&spec);
   double n_d = (double)spec.n_conicity, threads_d = 0.0;
   const char *path = cli_value(a, "out");
-  if (cli_vehicle(a, &veh, NULL) || cli_number(a, "conicity-min", &spec.conicity_min) ||
+  if (cli_model_kind(a, &kind) ||
+      (kind == HM_MODEL_WHEELSET ? cli_vehicle(a, &veh, NULL) : cli_vehicle_model(a, kind, &cm)) ||
+      cli_number(a, "conicity-min", &spec.conicity_min) ||
       cli_number(a, "conicity-max", &spec.conicity_max) || cli_number(a, "n", &n_d) ||
       cli_number(a, "v-min", &spec.speed_min_kmh) || cli_number(a, "v-max", &spec.speed_max_kmh) ||
       cli_number(a, "amp-max", &spec.amp_max_m) || cli_number(a, "threads", &threads_d))
@@ -48,7 +52,13 @@ int cmd_tables(const cli_args *a) {
   timespec_get(&t0, TIME_UTC);
   hm_table t = NULL;
   hm_threads threads = {(unsigned)threads_d};
-  hm_status st = hm_table_build_parallel(&veh, &spec, hm_threads_parallel_for, &threads, &t);
+  hm_car params;
+  hm_car_default(&params);
+  if (kind == HM_MODEL_BOGIE) params.bogie = cm.bogie.bogie;
+  if (kind == HM_MODEL_CAR) params = cm.car.car;
+  hm_status st = kind == HM_MODEL_WHEELSET
+                     ? hm_table_build_parallel(&veh, &spec, hm_threads_parallel_for, &threads, &t)
+                     : hm_table_build_model(kind, &params, &spec, hm_threads_parallel_for, &threads, &t);
   if (st == HM_EINVAL) {
     fprintf(stderr, "hunting tables: need 0 < --conicity-min < --conicity-max, 0 < --v-min < --v-max <= %g, "
                     "0.001 < --amp-max <= 0.1\n", HM_TABLE_MAX_SPEED_KMH);

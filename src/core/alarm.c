@@ -18,6 +18,7 @@ typedef struct {
 struct hm_alarm_s {
   hm_alarm_config cfg;            /* fallback and prior resolved for the vehicle */
   hm_vehicle veh;
+  hm_mode_model model;            /* a bogie's or car's (hm_alarm_set_model; borrowed), NULL: the wheelset's */
   double prior_hopf_low_kmh, prior_hopf_high_kmh; /* closed-form Hopf speeds at the prior's high and low ends */
   hm_table table;
   hm_level level;
@@ -206,10 +207,15 @@ hm_status hm_alarm_config_validate(const hm_alarm_config *c, char *why, size_t l
   return HM_EDOMAIN;
 }
 
+/* The Hopf speed at a conicity: the vehicle model's curve, or the wheelset's closed form. */
+static double hopf_kmh(const hm_vehicle *veh, hm_mode_model model, double conicity) {
+  return model ? hm_mode_model_hopf_kmh(model, conicity) : hm_linear_hopf_kmh(veh, conicity);
+}
+
 /* The configuration with the fallback and the prior resolved for the vehicle, and the prior's Hopf speeds; HM_EDOMAIN
  * (reason in why) for a prior that does not hold the fallback. */
-static hm_status resolve(const hm_alarm_config *cfg, const hm_vehicle *veh, hm_alarm_config *out, double *hopf_low,
-                         double *hopf_high, char *why, size_t len) {
+static hm_status resolve(const hm_alarm_config *cfg, const hm_vehicle *veh, hm_mode_model model, hm_alarm_config *out,
+                         double *hopf_low, double *hopf_high, char *why, size_t len) {
   hm_status st = hm_alarm_config_validate(cfg, why, len);
   if (st != HM_OK) return st;
   hm_alarm_config c = *cfg;
@@ -225,8 +231,8 @@ static hm_status resolve(const hm_alarm_config *cfg, const hm_vehicle *veh, hm_a
     return HM_EDOMAIN;
   }
   *out = c;
-  *hopf_low = hm_linear_hopf_kmh(veh, c.conicity_prior_high);
-  *hopf_high = hm_linear_hopf_kmh(veh, c.conicity_prior_low);
+  *hopf_low = hopf_kmh(veh, model, c.conicity_prior_high);
+  *hopf_high = hopf_kmh(veh, model, c.conicity_prior_low);
   return HM_OK;
 }
 
@@ -300,6 +306,14 @@ void hm_alarm_set_memory(hm_alarm a, double memory_s) {
   if (a && isfinite(memory_s) && memory_s > 0.0) a->memory_s = memory_s;
 }
 
+hm_status hm_alarm_set_model(hm_alarm a, hm_mode_model model) {
+  if (!a) return HM_EINVAL;
+  a->model = model;
+  const hm_alarm_config cfg = a->cfg;
+  const hm_vehicle veh = a->veh;
+  return hm_alarm_set_config(a, &cfg, &veh, NULL, 0); /* the prior's Hopf speeds from the model */
+}
+
 void hm_alarm_set_measurement_point(hm_alarm a, hm_measurement_point point) {
   if (a && (point == HM_POINT_WHEELSET || point == HM_POINT_BOGIE_FRAME)) a->point = point;
 }
@@ -340,7 +354,7 @@ hm_status hm_alarm_set_config(hm_alarm a, const hm_alarm_config *cfg, const hm_v
   if (!a || !cfg || !veh) return HM_EINVAL;
   hm_alarm_config c;
   double lo, hi;
-  const hm_status st = resolve(cfg, veh, &c, &lo, &hi, why, why_len);
+  const hm_status st = resolve(cfg, veh, a->model, &c, &lo, &hi, why, why_len);
   if (st != HM_OK) return st;
   a->cfg = c;
   a->veh = *veh;
@@ -399,7 +413,11 @@ static hm_status lookup(hm_alarm a, int k, double conicity, double speed_kmh, hm
   hm_status st = hm_table_lookup_widened(a->table, conicity, speed_kmh, &r);
   if (st == HM_EDOMAIN && isfinite(conicity) && isfinite(speed_kmh)) st = hm_table_lookup(a->table, conicity, speed_kmh, &r);
   if (st != HM_OK) return st;
-  if (r.conicity != conicity && !r.widened) r.hopf_speed_kmh = hm_linear_hopf_kmh(&a->veh, conicity);
+  if (r.conicity != conicity && !r.widened) r.hopf_speed_kmh = hopf_kmh(&a->veh, a->model, conicity);
+  if (a->model) { /* a model's Hopf curve is exact to HM_MODE_MODEL_CURVE_ERR_KMH where the table interpolates */
+    const double v = hopf_kmh(&a->veh, a->model, conicity);
+    if (v < HM_LINEAR_NO_HOPF_KMH) r.hopf_speed_kmh = v, r.error_speed_kmh = HM_MODE_MODEL_CURVE_ERR_KMH;
+  }
   a->cache[k].valid = 1;
   a->cache[k].conicity = conicity;
   a->cache[k].speed_kmh = speed_kmh;
@@ -499,7 +517,8 @@ static double warn_below_point(double point_kmh, double low_kmh, double margin_k
 static hm_status assess(hm_alarm a, const hm_estimate *e, const hm_margin_estimate *g, hm_assessment *s) {
   const hm_alarm_config *c = &a->cfg;
   const double now = s->time_s;
-  const int axle = a->point == HM_POINT_WHEELSET;
+  /* a bogie's or car's model holds the frame: a frame sensor shows one of its modes (issue #28) */
+  const int axle = a->point == HM_POINT_WHEELSET || (a->model && hm_mode_model_kind(a->model) != HM_MODEL_WHEELSET);
   const int have = c->use_conicity_estimate && g && g->conicity_valid && g->hopf_model_valid;
   /* the margin's flags as the level uses them, held against the provisional window's chatter (alarm.h) */
   const int mismatch = sticky(&a->mismatch, g && g->model_mismatch, now);
@@ -536,7 +555,7 @@ static hm_status assess(hm_alarm a, const hm_estimate *e, const hm_margin_estima
     hi = g->hopf_model_high_kmh;
     s->conicity_se = g->conicity_se;
   } else if (usable) {
-    if (g->hopf_model_kmh < hm_linear_hopf_kmh(&a->veh, lambda)) lambda = g->conicity, s->conicity_se = g->conicity_se;
+    if (g->hopf_model_kmh < hopf_kmh(&a->veh, a->model, lambda)) lambda = g->conicity, s->conicity_se = g->conicity_se;
     lo = fmin(lo, g->hopf_model_low_kmh);
     if (g->hopf_model_high_kmh < hi) hi = g->hopf_model_high_kmh, lambda_opt = g->conicity_low;
     /* the prior sets the interval only where the estimate moved neither end */

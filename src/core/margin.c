@@ -20,6 +20,7 @@ struct hm_margin_s {
   hm_margin_config cfg;
   hm_vehicle veh;
   hm_linear_coef coef;
+  hm_mode_model model;          /* a bogie's or car's (hm_margin_set_model; borrowed), NULL: the wheelset's closed forms */
   double lambda0;               /* the vehicle's lambda(0): the model-free line's curvature is taken there */
   window w[HM_MARGIN_MAX_WINDOWS];
   size_t head, n;
@@ -158,7 +159,25 @@ void hm_margin_reset(hm_margin m) {
 }
 
 double hm_margin_hopf_kmh(const hm_margin m, double conicity) {
-  return m ? hm_linear_hopf_kmh(&m->veh, conicity) : HM_LINEAR_NO_HOPF_KMH;
+  if (!m) return HM_LINEAR_NO_HOPF_KMH;
+  return m->model ? hm_mode_model_hopf_kmh(m->model, conicity) : hm_linear_hopf_kmh(&m->veh, conicity);
+}
+
+void hm_margin_set_model(hm_margin m, hm_mode_model model) {
+  if (m) m->model = model;
+}
+
+/* The vehicle's model: the conicity from a mode (inversion.h's closed form for the wheelset, mode_model.h's for a
+ * bogie or car) and its hunting root (the least-damped one) at a conicity and speed. */
+static hm_status invert(const hm_margin m, double speed_kmh, double sigma, double e_sigma, double f_hz, double e_f,
+                        hm_conicity_inversion *inv) {
+  return m->model ? hm_mode_model_invert(m->model, speed_kmh, sigma, e_sigma, f_hz, e_f, 1e-9, 60, inv)
+                  : hm_conicity_from_mode(&m->coef, speed_kmh, sigma, e_sigma, f_hz, e_f, 1e-9, 60, inv);
+}
+
+static hm_status hunting_root(const hm_margin m, double speed_kmh, double conicity, double *sigma, double *omega) {
+  return m->model ? hm_mode_model_least_damped(m->model, conicity, speed_kmh, sigma, omega)
+                  : hm_hunting_root(&m->coef, speed_kmh, conicity, sigma, omega);
 }
 
 /* A reading's checks and inversion into *w (a window of window_s seconds); the verdict says whether it can be used. */
@@ -180,20 +199,16 @@ static hm_window_verdict prepare_reading(const hm_margin m, double t_end, double
   double e_sigma = hypot(mode->decay_rate_se_1_s, sys_sigma);
   const double e_f = hypot(mode->frequency_se_hz, sys_f);
   hm_conicity_inversion inv;
-  if (hm_conicity_from_mode(&m->coef, speed_kmh, sigma, e_sigma, mode->frequency_hz, e_f, 1e-9, 60,
-                            &inv) != HM_OK)
-    return HM_WINDOW_NO_INVERSION;
+  if (invert(m, speed_kmh, sigma, e_sigma, mode->frequency_hz, e_f, &inv) != HM_OK) return HM_WINDOW_NO_INVERSION;
   /* the speed's range over the window: the fit averages the decay rates along it; the model's change over half the
    * range, at the conicity found, is a systematic error (on a ramp at 0.5 km/h/s, 12 km/h in 24 s, 0.4 1/s near the
    * Hopf speed of conicity 0.16), and the inversion is repeated with it */
   double s_lo, s_hi, w_unused;
-  if (spread_kmh > 0.0 && hm_hunting_root(&m->coef, speed_kmh - 0.5 * spread_kmh, inv.conicity, &s_lo, &w_unused) == HM_OK &&
-      hm_hunting_root(&m->coef, speed_kmh + 0.5 * spread_kmh, inv.conicity, &s_hi, &w_unused) == HM_OK) {
+  if (spread_kmh > 0.0 && hunting_root(m, speed_kmh - 0.5 * spread_kmh, inv.conicity, &s_lo, &w_unused) == HM_OK &&
+      hunting_root(m, speed_kmh + 0.5 * spread_kmh, inv.conicity, &s_hi, &w_unused) == HM_OK) {
     sys_sigma = hypot(sys_sigma, 0.5 * fabs(s_hi - s_lo));
     e_sigma = hypot(mode->decay_rate_se_1_s, sys_sigma);
-    if (hm_conicity_from_mode(&m->coef, speed_kmh, sigma, e_sigma, mode->frequency_hz, e_f, 1e-9, 60,
-                              &inv) != HM_OK)
-      return HM_WINDOW_NO_INVERSION;
+    if (invert(m, speed_kmh, sigma, e_sigma, mode->frequency_hz, e_f, &inv) != HM_OK) return HM_WINDOW_NO_INVERSION;
   }
   w->t_end_s = t_end;
   if (!(inv.chi2 <= c->max_misfit_chi2)) return HM_WINDOW_MISFIT;
@@ -277,8 +292,8 @@ static int tracks_speed(const hm_margin m, double speed_kmh, double lambda, cons
   if (!isfinite(k) || !(se > 0.0) || !(lambda > 0.0)) return 0;
   const double v1 = 0.98 * speed_kmh, v2 = 1.02 * speed_kmh;
   double s1, w1, s2, w2;
-  if (hm_hunting_root(&m->coef, v1, lambda, &s1, &w1) != HM_OK ||
-      hm_hunting_root(&m->coef, v2, lambda, &s2, &w2) != HM_OK || !(w1 > 0.0 && w2 > 0.0))
+  if (hunting_root(m, v1, lambda, &s1, &w1) != HM_OK || hunting_root(m, v2, lambda, &s2, &w2) != HM_OK ||
+      !(w1 > 0.0 && w2 > 0.0))
     return 0;
   const double k_model = log(w2 / w1) / log(v2 / v1);
   return k - k_model >= 3.0 * se && k >= 0.5;
@@ -484,7 +499,7 @@ static double student_t_for_z(double z, unsigned nu) {
 /* The model's decay rate [1/s] at x = 1000 / v (v in km/h) and the vehicle's lambda(0); NAN if it cannot be found. */
 static double model_sigma(const hm_margin m, double x) {
   double sg, om;
-  return hm_hunting_root(&m->coef, 1000.0 / x, m->lambda0, &sg, &om) == HM_OK ? sg : NAN;
+  return hunting_root(m, 1000.0 / x, m->lambda0, &sg, &om) == HM_OK ? sg : NAN;
 }
 
 /* (b): weighted least squares of sigma on x = 1000 / v; the zero of the line with Fieller's interval, widened by the

@@ -15,7 +15,8 @@ typedef struct {
 
 struct hm_monitor_s {
   hm_monitor_config cfg;
-  hm_vehicle veh;
+  hm_vehicle veh;                /* the (leading) wheelset's parameters */
+  hm_mode_model model;           /* a bogie's or car's model (owned), NULL for the wheelset */
   hm_table table;
   hm_estimator est;
   hm_modal modal;
@@ -113,24 +114,56 @@ hm_status hm_monitor_create(const hm_monitor_config *cfg, const hm_vehicle *veh,
   return hm_monitor_create_parallel(cfg, veh, table, NULL, NULL, out, why, len);
 }
 
+/* The table checked against the vehicle, or built for it. */
+static hm_status ready_table(const hm_monitor_config *cfg, const hm_vehicle *veh, hm_model_kind kind,
+                             const hm_car *params, hm_mode_model model, hm_table *table, hm_parallel_for_fn pfor,
+                             void *runner, char *why, size_t len) {
+  if (*table)
+    return model ? hm_table_check_model(*table, model, HM_TABLE_CHECK_TOL_KMH, why, len)
+                 : hm_table_check_vehicle(*table, veh, HM_TABLE_CHECK_TOL_KMH, why, len);
+  hm_table_spec spec;
+  hm_table_spec_default(&spec);
+  spec.n_conicity = cfg->table_n_conicity;
+  const hm_status st = model ? hm_table_build_model(kind, params, &spec, pfor, runner, table)
+                             : hm_table_build_parallel(veh, &spec, pfor, runner, table);
+  if (st != HM_OK && why && len) snprintf(why, len, "computing the boundary tables: %s", hm_status_str(st));
+  return st;
+}
+
 hm_status hm_monitor_create_parallel(const hm_monitor_config *cfg, const hm_vehicle *veh, hm_table table,
                                      hm_parallel_for_fn pfor, void *runner, hm_monitor *out, char *why, size_t len) {
-  hm_status st = !cfg || !veh || !out ? HM_EINVAL : hm_monitor_config_validate(cfg, why, len);
-  if (st == HM_OK) st = hm_vehicle_validate(veh, why, len);
-  if (st == HM_OK && table) st = hm_table_check_vehicle(table, veh, HM_TABLE_CHECK_TOL_KMH, why, len);
-  if (st == HM_OK && !table) {
-    hm_table_spec spec;
-    hm_table_spec_default(&spec);
-    spec.n_conicity = cfg->table_n_conicity;
-    st = hm_table_build_parallel(veh, &spec, pfor, runner, &table);
-    if (st != HM_OK && why && len) snprintf(why, len, "computing the boundary tables: %s", hm_status_str(st));
+  if (!veh) {
+    hm_table_destroy(table);
+    return HM_EINVAL;
   }
+  hm_car params;
+  hm_car_default(&params);
+  params.bogie.wheelset = *veh;
+  return hm_monitor_create_model(cfg, HM_MODEL_WHEELSET, &params, table, pfor, runner, out, why, len);
+}
+
+hm_status hm_monitor_create_model(const hm_monitor_config *cfg, hm_model_kind kind, const hm_car *params,
+                                  hm_table table, hm_parallel_for_fn pfor, void *runner, hm_monitor *out, char *why,
+                                  size_t len) {
+  hm_status st = !cfg || !params || !out ? HM_EINVAL : hm_monitor_config_validate(cfg, why, len);
+  const hm_vehicle *veh = params ? &params->bogie.wheelset : NULL;
+  hm_mode_model model = NULL;
+  if (st == HM_OK) {
+    st = kind == HM_MODEL_WHEELSET ? hm_vehicle_validate(veh, why, len)
+       : kind == HM_MODEL_BOGIE   ? hm_bogie_validate(&params->bogie, why, len)
+       : kind == HM_MODEL_CAR     ? hm_car_validate(params, why, len)
+                                  : HM_EINVAL;
+  }
+  if (st == HM_OK && kind != HM_MODEL_WHEELSET) st = hm_mode_model_create(kind, params, &model);
+  if (st == HM_OK) st = ready_table(cfg, veh, kind, params, model, &table, pfor, runner, why, len);
   hm_monitor m = st == HM_OK ? calloc(1, sizeof *m) : NULL;
   if (st == HM_OK && !m) st = HM_ENOMEM;
   if (st != HM_OK) {
     hm_table_destroy(table);
+    hm_mode_model_destroy(model);
     return st;
   }
+  m->model = model;
   m->cfg = *cfg;
   m->veh = *veh;
   m->table = table;
@@ -141,6 +174,10 @@ hm_status hm_monitor_create_parallel(const hm_monitor_config *cfg, const hm_vehi
   if (st == HM_OK) st = hm_modal_create(&cfg->modal, cfg->estimator.sample_rate_hz, &m->modal, why, len);
   if (st == HM_OK) st = hm_margin_create(&cfg->margin, veh, &m->margin, why, len);
   if (st == HM_OK) st = hm_alarm_create(&cfg->alarm, veh, table, &m->alarm, why, len);
+  if (st == HM_OK && model) {
+    hm_margin_set_model(m->margin, model);
+    st = hm_alarm_set_model(m->alarm, model);
+  }
   if (st == HM_OK) st = hm_track_lines_init(&m->lines, &cfg->track_lines, why, len);
   if (st != HM_OK) {
     hm_monitor_destroy(m);
@@ -169,6 +206,7 @@ void hm_monitor_destroy(hm_monitor m) {
   hm_modal_destroy(m->modal);
   hm_estimator_destroy(m->est);
   hm_table_destroy(m->table);
+  hm_mode_model_destroy(m->model);
   free(m->chunks);
   free(m);
 }
@@ -444,7 +482,8 @@ hm_status hm_monitor_replace_table(hm_monitor m, hm_table table, hm_table *repla
     hm_table_destroy(table);
     return HM_EINVAL;
   }
-  const hm_status st = hm_table_check_vehicle(table, &m->veh, HM_TABLE_CHECK_TOL_KMH, why, len);
+  const hm_status st = m->model ? hm_table_check_model(table, m->model, HM_TABLE_CHECK_TOL_KMH, why, len)
+                                : hm_table_check_vehicle(table, &m->veh, HM_TABLE_CHECK_TOL_KMH, why, len);
   if (st != HM_OK) {
     hm_table_destroy(table);
     return st;
@@ -454,6 +493,10 @@ hm_status hm_monitor_replace_table(hm_monitor m, hm_table table, hm_table *repla
   else hm_table_destroy(m->table);
   m->table = table;
   return HM_OK;
+}
+
+hm_model_kind hm_monitor_model_kind(const hm_monitor m) {
+  return m && m->model ? hm_mode_model_kind(m->model) : HM_MODEL_WHEELSET;
 }
 
 void hm_monitor_vehicle(const hm_monitor m, hm_vehicle *veh) {

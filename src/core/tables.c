@@ -2,6 +2,10 @@
  * is in tables_io.c. */
 #include "hunting_monitor/tables.h"
 
+#include "hunting_monitor/car.h"
+#include "hunting_monitor/mode_model.h"
+#include "hunting_monitor/system_cycles.h"
+
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -305,6 +309,81 @@ static hm_status curve_at(const hm_vehicle *veh, const hm_table_spec *spec, doub
   return st;
 }
 
+/* The polyline of a family: the Hopf point (amplitude 0), then the branch with its located folds as vertices (a fold
+ * between two points is the branch's extreme there; flagged stable, each segment beside it takes the stability of its
+ * other end), decimated; the table's curve at the conicity. Takes tp (m points' room at least np + ne + 1). */
+static void family_curve(double conicity, double hopf_kmh, double l1, const double *pv, const double *pa,
+                         const int *ps, size_t np, const size_t *ev_index, const double *ev_v, const double *ev_a,
+                         size_t ne, tpoint *tp, tcurve *out) {
+  double lowest = hopf_kmh;
+  size_t m = 0, k = 0;
+  tp[m++] = (tpoint){hopf_kmh, 0.0, ps[0]};
+  for (size_t i = 0; i < np; ++i) {
+    for (; k < ne && ev_index[k] <= i; ++k)
+      if (ev_index[k] == i && i > 0) {
+        tp[m++] = (tpoint){ev_v[k], ev_a[k], 1};
+        lowest = fmin(lowest, ev_v[k]);
+      }
+    tp[m++] = (tpoint){pv[i], pa[i], ps[i]};
+    lowest = fmin(lowest, pv[i]);
+  }
+  *out = (tcurve){conicity, hopf_kmh, l1, lowest, decimate(tp, m), tp};
+}
+
+/* A bogie's or car's curve at a conicity: its critical speed (the first crossing from 100 km/h) and its family of
+ * cycles (system_cycles.h); l1 is not known without a normal form: its sign only (+1 when the family starts towards
+ * lower speeds, subcritical). */
+static hm_status curve_at_model(hm_model_kind kind, const hm_car *params, const hm_table_spec *spec, double conicity,
+                                tcurve *out) {
+  hm_car c = *params;
+  hm_status st = hm_vehicle_set_conicity_at_zero(&c.bogie.wheelset, conicity);
+  if (st != HM_OK) return st;
+  hm_bogie_model bm;
+  hm_car_model cm;
+  hm_system sys;
+  st = kind == HM_MODEL_CAR ? hm_car_model_init(&cm, &c, 0, &sys) : hm_bogie_model_init(&bm, &c.bogie, 0, &sys);
+  if (st != HM_OK) return st;
+  hm_system_critical_options copt;
+  hm_system_critical_options_default(&copt);
+  double vh_mps;
+  if ((st = hm_system_critical_speed(&sys, &copt, &vh_mps, NULL)) != HM_OK) return st;
+  const double vh = hm_kmh_from_mps(vh_mps);
+  hm_system_cycle_options o;
+  hm_system_cycle_options_default(&o);
+  o.v_min_kmh = fmin(spec->speed_min_kmh, 0.9 * vh);
+  o.v_max_kmh = fmax(spec->speed_max_kmh, 1.2 * vh);
+  o.amp_max_m = spec->amp_max_m;
+  o.shoot.rtol = spec->rtol;
+  o.shoot.atol = spec->rtol * 1e-3;
+  const size_t CAP = o.cont.max_steps + 2;
+  enum { MAX_EV = 64 };
+  hm_system_cycle_point *pts = malloc(CAP * sizeof *pts);
+  double *pv = malloc(CAP * sizeof *pv), *pa = malloc(CAP * sizeof *pa);
+  int *ps = malloc(CAP * sizeof *ps);
+  tpoint *tp = malloc((CAP + MAX_EV + 1) * sizeof *tp);
+  hm_system_cycle_event ev[MAX_EV];
+  size_t np = 0, ne = 0, ev_index[MAX_EV];
+  double ev_v[MAX_EV], ev_a[MAX_EV];
+  if (!pts || !pv || !pa || !ps || !tp) st = HM_ENOMEM;
+  if (st == HM_OK) st = hm_system_cycles_continue(&sys, &o, pts, CAP, &np, ev, MAX_EV, &ne, NULL);
+  if (st == HM_OK && np > 1) {
+    size_t nl = 0;
+    for (size_t i = 0; i < np; ++i) pv[i] = pts[i].speed_kmh, pa[i] = pts[i].amp_m, ps[i] = pts[i].stable;
+    for (size_t k = 0; k < ne; ++k)
+      if (ev[k].kind == HM_CYCLE_LPC) ev_index[nl] = ev[k].index, ev_v[nl] = ev[k].point.speed_kmh,
+                                      ev_a[nl++] = ev[k].point.amp_m;
+    const double l1 = pts[1].speed_kmh < pts[0].speed_kmh ? 1.0 : -1.0;
+    family_curve(conicity, vh, l1, pv, pa, ps, np, ev_index, ev_v, ev_a, nl, tp, out);
+    tpoint *shrunk = realloc(out->pts, out->n * sizeof *tp);
+    if (shrunk) out->pts = shrunk;
+    tp = NULL;
+  } else if (st == HM_OK) {
+    st = HM_ENOCONV;
+  }
+  free(pts), free(pv), free(pa), free(ps), free(tp);
+  return st;
+}
+
 /* Largest difference between the table (without the midpoint curve) and the computed midpoint curve. */
 static void midpoint_errors(hm_table t, const tcurve *mid, double *e_hopf, double *e_low, double *e_amp) {
   hm_table_lookup_result r;
@@ -354,9 +433,26 @@ hm_status hm_table_check_vehicle(const hm_table t, const hm_vehicle *veh, double
   return HM_OK;
 }
 
+hm_status hm_table_check_model(const hm_table t, hm_mode_model model, double tol_kmh, char *why, size_t len) {
+  if (!t || !model || !(tol_kmh > 0.0)) return HM_EINVAL;
+  for (size_t i = 0; i < t->n; ++i) {
+    double v = NAN;
+    if (hm_mode_model_hopf(model, t->curves[i].conicity, &v, NULL, NULL) != HM_OK) v = NAN;
+    if (!(fabs(v - t->curves[i].hopf_kmh) <= tol_kmh)) {
+      if (why && len)
+        snprintf(why, len, "table Hopf speed %g km/h at conicity %g does not match the %s's %g km/h",
+                 t->curves[i].hopf_kmh, t->curves[i].conicity, hm_model_kind_name(hm_mode_model_kind(model)), v);
+      return HM_EDOMAIN;
+    }
+  }
+  return HM_OK;
+}
+
 /* The families of a build: grid curves 0..n-1, then midpoints n..2n-2; each job fills its own slot. */
 typedef struct {
   const hm_vehicle *veh;
+  hm_model_kind kind;    /* the wheelset (veh), or a bogie's or car's (params) */
+  const hm_car *params;
   const hm_table_spec *spec;
   tcurve *curves;
   hm_status *status;
@@ -366,8 +462,9 @@ typedef struct {
 static void build_job(void *ctx, size_t i) {
   build_ctx *b = (build_ctx *)ctx;
   const double dc = (b->spec->conicity_max - b->spec->conicity_min) / (double)(b->n - 1);
-  const double at = i < b->n ? (double)i : (double)(i - b->n) + 0.5;
-  b->status[i] = curve_at(b->veh, b->spec, b->spec->conicity_min + dc * at, &b->curves[i]);
+  const double at = i < b->n ? (double)i : (double)(i - b->n) + 0.5, lambda = b->spec->conicity_min + dc * at;
+  b->status[i] = b->kind == HM_MODEL_WHEELSET ? curve_at(b->veh, b->spec, lambda, &b->curves[i])
+                                              : curve_at_model(b->kind, b->params, b->spec, lambda, &b->curves[i]);
 }
 
 static void run_in_order(void *runner, size_t n, hm_job_fn job, void *ctx) {
@@ -375,11 +472,10 @@ static void run_in_order(void *runner, size_t n, hm_job_fn job, void *ctx) {
   for (size_t i = 0; i < n; ++i) job(ctx, i);
 }
 
-hm_status hm_table_build_parallel(const hm_vehicle *veh, const hm_table_spec *spec, hm_parallel_for_fn pfor,
-                                  void *runner, hm_table *out) {
-  if (!veh || !spec || !out || !spec_valid(spec)) return HM_EINVAL;
-  hm_status st = hm_vehicle_validate(veh, NULL, 0);
-  if (st != HM_OK) return st;
+static hm_status build(hm_model_kind kind, const hm_car *params, const hm_table_spec *spec, hm_parallel_for_fn pfor,
+                       void *runner, hm_table *out) {
+  const hm_vehicle *veh = &params->bogie.wheelset;
+  hm_status st = HM_OK;
   const size_t n = spec->n_conicity, jobs = 2 * n - 1;
   hm_table t = hm_table_alloc(n);
   tcurve *curves = calloc(jobs, sizeof *curves);
@@ -391,7 +487,7 @@ hm_status hm_table_build_parallel(const hm_vehicle *veh, const hm_table_spec *sp
     return HM_ENOMEM;
   }
   for (size_t i = 0; i < jobs; ++i) status[i] = HM_EINVAL; /* a job the runner skipped fails the build */
-  build_ctx b = {veh, spec, curves, status, n};
+  build_ctx b = {veh, kind, params, spec, curves, status, n};
   (pfor ? pfor : run_in_order)(runner, jobs, build_job, &b);
   for (size_t i = 0; i < jobs && st == HM_OK; ++i) st = status[i];
   t->kx_mn_m = veh->stiffness_long_n_m / 1e6;
@@ -419,6 +515,25 @@ hm_status hm_table_build_parallel(const hm_vehicle *veh, const hm_table_spec *sp
   t->rtol = spec->rtol;
   *out = t;
   return HM_OK;
+}
+
+hm_status hm_table_build_parallel(const hm_vehicle *veh, const hm_table_spec *spec, hm_parallel_for_fn pfor,
+                                  void *runner, hm_table *out) {
+  if (!veh || !spec || !out || !spec_valid(spec)) return HM_EINVAL;
+  hm_status st = hm_vehicle_validate(veh, NULL, 0);
+  if (st != HM_OK) return st;
+  hm_car c;
+  hm_car_default(&c);
+  c.bogie.wheelset = *veh;
+  return build(HM_MODEL_WHEELSET, &c, spec, pfor, runner, out);
+}
+
+hm_status hm_table_build_model(hm_model_kind kind, const hm_car *params, const hm_table_spec *spec,
+                               hm_parallel_for_fn pfor, void *runner, hm_table *out) {
+  if (!params || !spec || !out || !spec_valid(spec) || (kind != HM_MODEL_BOGIE && kind != HM_MODEL_CAR))
+    return HM_EINVAL;
+  hm_status st = kind == HM_MODEL_CAR ? hm_car_validate(params, NULL, 0) : hm_bogie_validate(&params->bogie, NULL, 0);
+  return st == HM_OK ? build(kind, params, spec, pfor, runner, out) : st;
 }
 
 hm_status hm_table_family(const hm_table t, double conicity, hm_family_point *points, size_t max, size_t *n,

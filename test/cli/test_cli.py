@@ -1109,6 +1109,40 @@ def test_bogie_and_car_simulate():
         assert p.returncode != 0 and "'roof' is not a place on a car" in p.stderr, p.stderr
 
 
+def test_estimate_on_a_bogie_model():
+    """`hunting estimate --config bogie.yaml`: the monitor on the bogie's model (issue #28). Its boundary table from
+    `hunting tables --config`, refused by a wheelset monitor; before any window the Hopf interval is the prior's
+    conicities (the configured 0.1358 -+ 0.03) through the bogie's own critical speeds (`hunting critical --config
+    --conicity`, a separate path: eigenvalue bisection against the monitor's interpolated curve, to 0.05 km/h); a frame
+    accelerometer's windows read as the bogie's conicity; state files are refused for a bogie (not yet)."""
+    bogie = os.path.join(SRC, "config", "bogie_default.yaml")
+    with tempfile.TemporaryDirectory() as d:
+        tbl, acc, spd = (os.path.join(d, n) for n in ("b.tbl", "a.csv", "s.csv"))
+        out = run_json("tables", "--config", bogie, "--out", tbl, "--n", "4", "--conicity-min", "0.10",
+                       "--conicity-max", "0.19")
+        assert out["conicities"] == 4, out
+        run("simulate", "--config", bogie, "--profile", "0:470,80:470", "--t", "80", "--irregularity", "0.3",
+            "--seed", "5", "--sensor", "frame", "--dt-out", "0.002", "--accel-noise", "0.1", "--accel-out", acc,
+            "--speed-out", spd)
+        mon = write_file(d, "mon.yaml", open(os.path.join(SRC, "config", "monitor.yaml")).read().replace(
+            "measurement_point: wheelset", "measurement_point: bogie_frame"))
+        rows = lines(run("estimate", "--config", bogie, "--table", tbl, "--monitor", mon, "--accel", acc, "--speed",
+                         spd, "--every", "5").stdout)
+        lo = run_json("critical", "--config", bogie, "--conicity", str(0.1358 + 0.03))["v_crit_kmh"]
+        hi = run_json("critical", "--config", bogie, "--conicity", str(0.1358 - 0.03))["v_crit_kmh"]
+        first = rows[0]
+        assert first["conicity_estimate"] is None, first["conicity_estimate"]
+        close(first["hopf_kmh_low"], lo, 0.05, "the prior's lower end by the bogie's model")
+        close(first["hopf_kmh_high"], hi, 0.05, "the prior's upper end by the bogie's model")
+        last = rows[-1]
+        assert last["conicity_estimate"] is not None and abs(last["conicity_estimate"] - 0.1358) < 0.02, last
+        p = run("estimate", "--table", tbl, "--accel", acc, "--speed", spd, ok=False)
+        assert p.returncode != 0 and "not for this vehicle" in p.stderr, p.stderr
+        p = run("estimate", "--config", bogie, "--table", tbl, "--accel", acc, "--speed", spd, "--state-out",
+                os.path.join(d, "st"), ok=False)
+        assert p.returncode != 0 and "take the wheelset model" in p.stderr, p.stderr
+
+
 def main():
     global failures
     tests = [(n, f) for n, f in globals().items() if n.startswith("test_") and callable(f)]
