@@ -1,6 +1,7 @@
-// hunting_sim_node: integrates the C core's nonlinear wheelset model on an irregular track along a speed profile
-// and publishes what a vehicle's sensors would: lateral acceleration (sensor_msgs/Imu, stamped, with noise) and
-// speed (std_msgs/Float64, km/h). Exits after ~duration_s (so a launch marked required ends with it).
+// hunting_sim_node: integrates the C core's nonlinear vehicle model (the wheelset, or with ~model a bogie or a car,
+// its accelerometer where ~sensor says: axlebox, frame, carbody) on an irregular track along a speed profile and
+// publishes what a vehicle's sensors would: lateral acceleration (sensor_msgs/Imu, stamped, with noise) and speed
+// (std_msgs/Float64, km/h). Exits after ~duration_s (so a launch marked required ends with it).
 #include <ros/ros.h>
 #include <sensor_msgs/Imu.h>
 #include <std_msgs/Float64.h>
@@ -11,6 +12,8 @@
 #include "yaml_params.h"
 
 extern "C" {
+#include "hunting_monitor/bogie.h"
+#include "hunting_monitor/car.h"
 #include "hunting_monitor/sensor_sim.h"
 }
 
@@ -47,12 +50,14 @@ int publishSpeed(void* ctx, double, double speed_kmh) {
 int main(int argc, char** argv) {
   ros::init(argc, argv, "hunting_sim");
   ros::NodeHandle nh, pnh("~");
-  hm_vehicle veh;
+  hm_model_kind kind;
+  static hm_car params;  // the car's, its bogie's or its wheelset's
   std::string error;
-  if (!hunting_monitor::loadVehicleParams(pnh, &veh, &error)) {
+  if (!hunting_monitor::loadVehicleModelParams(pnh, &kind, &params, &error)) {
     ROS_FATAL("hunting_sim: %s", error.c_str());
     return 1;
   }
+  hm_vehicle& veh = params.bogie.wheelset;
   hm_sensor_sim_config cfg;
   hm_sensor_sim_config_default(&cfg);
   double hold_s, kick_s, kick_m;
@@ -94,7 +99,30 @@ int main(int argc, char** argv) {
   cfg.track_seed = cfg.noise_seed = static_cast<uint64_t>(seed);
   hm_sensor_sim sim = nullptr;
   char why[160] = "";
-  if (hm_sensor_sim_create(&veh, &cfg, nullptr, &sim, why, sizeof why) != HM_OK) {
+  static hm_bogie_model bogie;  // the system points into them for the whole run
+  static hm_car_model car;
+  hm_system sys;
+  hm_sensor_point point;
+  std::string where;
+  pnh.param<std::string>("sensor", where, "axlebox");
+  hm_status st = HM_OK;
+  if (kind == HM_MODEL_BOGIE) {
+    st = hm_bogie_model_init(&bogie, &params.bogie, 0, &sys);
+    if (st == HM_OK) st = hm_bogie_sensor(&bogie, where.c_str(), &point);
+  } else if (kind == HM_MODEL_CAR) {
+    st = hm_car_model_init(&car, &params, 0, &sys);
+    if (st == HM_OK) st = hm_car_sensor(&car, where.c_str(), &point);
+  } else if (where != "axlebox") {
+    st = HM_EINVAL;
+  }
+  if (st != HM_OK) {
+    ROS_FATAL("hunting_sim: ~sensor '%s': not a place on a %s (axlebox%s)", where.c_str(), hm_model_kind_name(kind),
+              kind == HM_MODEL_WHEELSET ? "" : kind == HM_MODEL_BOGIE ? ", frame" : ", frame, carbody");
+    return 1;
+  }
+  st = kind == HM_MODEL_WHEELSET ? hm_sensor_sim_create(&veh, &cfg, nullptr, &sim, why, sizeof why)
+                                 : hm_sensor_sim_create_system(&sys, &point, &cfg, nullptr, &sim, why, sizeof why);
+  if (st != HM_OK) {
     ROS_FATAL("hunting_sim: %s", why);
     return 1;
   }
@@ -108,9 +136,9 @@ int main(int argc, char** argv) {
   while (ros::ok() && hm_sensor_sim_time(sim) < duration) {
     const double t = hm_sensor_sim_time(sim);
     const double target = std::fmin((ros::Time::now() - pub.t0).toSec(), duration);
-    hm_status st = HM_OK;
+    st = HM_OK;
     if (kick_s >= 0.0 && t < kick_s && target >= kick_s) {  // a lateral disturbance, once
-      double x[4];
+      double x[HM_SYSTEM_MAX_DIM];  // the leading wheelset's y first
       st = hm_sensor_sim_run(sim, kick_s, &sink);
       hm_sensor_sim_state(sim, x);
       x[0] += kick_m;

@@ -69,6 +69,31 @@ std::string sectionsAsYaml(const ros::NodeHandle& nh, const std::vector<std::str
   return out.str();
 }
 
+bool loadVehicleModelParams(const ros::NodeHandle& nh, hm_model_kind* kind, hm_car* params, std::string* error) {
+  const std::string yaml = sectionsAsYaml(nh, {"model", "vehicle", "conicity", "flange", "bogie", "car"});
+  char err[512] = "";
+  const char* src = "~ (vehicle parameters)";
+  hm_model_kind k = HM_MODEL_WHEELSET;
+  hm_car c;
+  hm_car_default(&c);
+  hm_status st = hm_config_model_kind(yaml.c_str(), yaml.size(), src, &k, err, sizeof err);
+  if (st == HM_OK) {
+    if (k == HM_MODEL_WHEELSET)
+      st = hm_config_parse_vehicle(yaml.c_str(), yaml.size(), src, &c.bogie.wheelset, nullptr, err, sizeof err);
+    else if (k == HM_MODEL_BOGIE)
+      st = hm_config_parse_bogie(yaml.c_str(), yaml.size(), src, &c.bogie, nullptr, err, sizeof err);
+    else
+      st = hm_config_parse_car(yaml.c_str(), yaml.size(), src, &c, nullptr, err, sizeof err);
+  }
+  if (st != HM_OK) {
+    *error = err;
+    return false;
+  }
+  *kind = k;
+  *params = c;
+  return true;
+}
+
 bool loadVehicleParams(const ros::NodeHandle& nh, hm_vehicle* vehicle, std::string* error) {
   const std::string yaml = sectionsAsYaml(nh, {"vehicle", "conicity", "flange"});
   char err[512] = "";
