@@ -133,8 +133,8 @@ int cli_vehicle(const cli_args *a, hm_vehicle *veh, char *name) {
       hm_model_kind kind = HM_MODEL_WHEELSET;
       const int other_model = hm_config_load_model_kind(path, &kind, NULL, 0) == HM_OK && kind != HM_MODEL_WHEELSET;
       fprintf(stderr, "hunting: config error: %s%s\n", err,
-              other_model ? " (this command takes the wheelset model; `hunting critical` and `hunting eig` take a "
-                            "bogie)"
+              other_model ? " (this command takes the wheelset model; critical, eig, cycles, simulate, tables and "
+                            "estimate take a bogie or car)"
                           : "");
       return 1;
     }

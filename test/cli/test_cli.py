@@ -1026,7 +1026,7 @@ def test_bogie_critical_and_eig():
         close(re, z.real, 1e-7 * abs(z), "bogie eigenvalue (real)")
         close(im, z.imag, 1e-7 * abs(z), "bogie eigenvalue (imaginary)")
     # a bogie config where a wheelset is expected, and a bad bogie: clear errors
-    p = run("simulate", "--config", cfg, "--v", "300", ok=False)
+    p = run("hopf", "--config", cfg, ok=False)
     assert p.returncode != 0 and "model: 'bogie' where a wheelset config is expected" in p.stderr, p.stderr
     with tempfile.TemporaryDirectory() as d:
         bad = write_file(d, "bad.yaml", open(cfg).read().replace("frame_mass_kg: 2600", "frame_mass_kg: -5"))
