@@ -69,11 +69,12 @@ typedef struct {
   hm_linear_coef coef;  /* the wheelset's coefficients (MODEL.md section 2) */
   int frame_held;       /* 1: the frame held at rest, 8 states */
   double inertia[HM_BOGIE_DIM], scale[HM_BOGIE_DIM], x_m[2];
+  size_t y_state[2];
   int body[HM_BOGIE_DIM];
 } hm_bogie_model;
 
 /* Validate and fill *m and *sys (sys points into m: keep m). Bodies: 0 "wheelsets", 1 "bogie frame"; a cycle's
- * amplitude is the leading wheelset's y; odd when lambda(y) is even. */
+ * amplitude is the largest |y| of its two wheelsets (the phase on the leading one's); odd when lambda(y) is even. */
 hm_status hm_bogie_model_init(hm_bogie_model *m, const hm_bogie *bogie, int frame_held, hm_system *sys);
 
 /* f(x; v) at track displacements y_track[2] under the two wheelsets (NULL: 0): lambda and F_T act on y_i - y_track_i.

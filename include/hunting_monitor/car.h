@@ -49,6 +49,7 @@ typedef struct {
   hm_bogie_model bogie;   /* the bogies' equations (frame free) */
   int carbody_held;
   double inertia[HM_CAR_DIM], scale[HM_CAR_DIM], x_m[4];
+  size_t y_state[4];
   int body[HM_CAR_DIM];
 } hm_car_model;
 

@@ -13,12 +13,14 @@
  * with the sensitivity ds/dlambda by central differences (step 1e-6 lambda), the root followed from the last one;
  * converged when the step is below tol; HM_ENOCONV after max_iter or outside 0 < lambda < 10. Its standard error and
  * chi2 as inversion.h's. For the wheelset it gives inversion.h's numbers (test_mode_model: to 1e-7).
- * The Hopf speed at a conicity: hm_system_critical_speed (100-1500 km/h, 5 km/h scan, bisection to 1e-6 km/h), the
- * first crossing of any mode, and whose mode that is.
+ * The Hopf speed at a conicity: hm_system_critical_speed (HM_MODE_MODEL_V_MIN_KMH-1500 km/h, 5 km/h scan, bisection
+ * to 1e-6 km/h), the first crossing of any mode, and whose mode that is.
  * The Hopf curve for the monitor (hm_mode_model_hopf_kmh): the exact speed at HM_MODE_MODEL_GRID conicities spaced
  * geometrically over [HM_MODE_MODEL_LAMBDA_MIN, HM_MODE_MODEL_LAMBDA_MAX], each computed when first needed, and
  * 1/V^2 interpolated linearly in the conicity between them (exact for the wheelset, whose Hurwitz condition is affine
- * in lambda; for the bogie within 0.05 km/h where one mode stays critical, test_mode_model).
+ * in lambda; for the bogie within 0.05 km/h where one mode stays critical, test_mode_model); between grid points
+ * whose critical modes differ in frequency by more than HM_MODE_MODEL_KINK_HZ (a kink: the bogie's wheelsets' mode
+ * giving way to its frame's) the exact speed; 0 where the vehicle is unstable already at HM_MODE_MODEL_V_MIN_KMH.
  * One model is used by one thread at a time (it holds its parameters, system and curve); create allocates, nothing
  * after.
  */
@@ -40,7 +42,11 @@ extern "C" {
 #define HM_MODE_MODEL_GRID 160
 #define HM_MODE_MODEL_LAMBDA_MIN 0.01
 #define HM_MODE_MODEL_LAMBDA_MAX 2.0
-#define HM_MODE_MODEL_CURVE_ERR_KMH 0.05 /* the curve's stated error against the exact Hopf speed (test_mode_model) */
+#define HM_MODE_MODEL_CURVE_ERR_KMH 0.05
+#define HM_MODE_MODEL_V_MIN_KMH 1.0     /* the Hopf search starts here */
+#define HM_MODE_MODEL_KINK_HZ 0.5       /* neighbouring grid points whose critical modes differ more: exact between */
+#define HM_MODE_MODEL_BAND_LOW_HZ 2.0   /* the least-damped root's default band: hunting, not a carbody's sway */
+#define HM_MODE_MODEL_BAND_HIGH_HZ 30.0 /* the curve's stated error against the exact Hopf speed (test_mode_model) */
 
 typedef struct hm_mode_model_s *hm_mode_model;
 
@@ -55,16 +61,20 @@ void hm_mode_model_destroy(hm_mode_model m);
 hm_status hm_mode_model_create(hm_model_kind kind, const hm_car *params, hm_mode_model *out);
 
 hm_model_kind hm_mode_model_kind(const hm_mode_model m);
+/* The band [Hz] the least-damped root is sought in (0 <= low < high). */
+hm_status hm_mode_model_set_band(hm_mode_model m, double low_hz, double high_hz);
 /* The parameters the model was made with (the conicity as given at creation). */
 void hm_mode_model_params(const hm_mode_model m, hm_car *params);
 
-/* The least-damped oscillatory root at conicity and speed (the largest real part with a positive imaginary part):
- * the mode that goes unstable first. */
+/* The least-damped oscillatory root at conicity and speed whose frequency lies in the model's band (by default
+ * HM_MODE_MODEL_BAND_LOW_HZ..HIGH_HZ; the monitor sets its identification's band): the hunting mode that goes
+ * unstable first, not a car's 0.6 Hz carbody sway. HM_ENOCRIT if none in the band. */
 hm_status hm_mode_model_least_damped(hm_mode_model m, double conicity, double speed_kmh, double *sigma_1_s,
                                      double *omega_rad_s);
 
-/* The Hopf speed at a conicity from the curve above [km/h]; HM_LINEAR_NO_HOPF_KMH (linear.h) where there is none
- * in 100-1500 km/h or the conicity is outside the grid's range; computes grid points on first need. */
+/* The Hopf speed at a conicity from the curve above [km/h]; HM_LINEAR_NO_HOPF_KMH (linear.h) where the origin is
+ * stable up to 1500 km/h or the conicity is outside the grid's range, 0 where it is unstable at every speed; computes
+ * grid points on first need. */
 double hm_mode_model_hopf_kmh(hm_mode_model m, double conicity);
 
 /* The hunting root at conicity and speed nearest the reference mode (errors e_sigma [1/s], e_f [Hz] > 0 weigh the
@@ -73,7 +83,7 @@ hm_status hm_mode_model_root(hm_mode_model m, double conicity, double speed_kmh,
                              double f_ref_hz, double e_f, double *sigma_1_s, double *f_hz);
 
 /* The linear critical speed at a conicity [km/h], its frequency [Hz] and the body its mode moves (system.h's
- * body index; NULLs allowed). HM_ENOCRIT if none in 100-1500 km/h. */
+ * body index; NULLs allowed). HM_ENOCRIT if none in HM_MODE_MODEL_V_MIN_KMH-1500 km/h. */
 hm_status hm_mode_model_hopf(hm_mode_model m, double conicity, double *speed_kmh, double *f_hz, int *body);
 
 /* The conicity whose hunting root is nearest the measured mode (above); inputs as inversion.h's. */

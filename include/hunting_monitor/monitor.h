@@ -102,6 +102,8 @@ hm_status hm_monitor_create_model(const hm_monitor_config *cfg, hm_model_kind ki
                                   hm_table table, hm_parallel_for_fn pfor, void *runner, hm_monitor *out, char *why,
                                   size_t why_len);
 hm_model_kind hm_monitor_model_kind(const hm_monitor m);
+/* The model's parameters (for the wheelset: hm_car_default's with its wheelset). */
+void hm_monitor_model_params(const hm_monitor m, hm_car *params);
 void hm_monitor_destroy(hm_monitor m);
 /* Forget the stream (the time line restarted, by an unknown step): estimator, identification, the margin's windows
  * (their times are on the old line) and the alarm's hold; a held ALARM stays held with its hunted-at speed (a latch

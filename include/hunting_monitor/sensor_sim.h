@@ -73,7 +73,8 @@ size_t hm_sensor_sim_dim(const hm_sensor_sim sim);
 
 /* Integrate to t_end_s (>= the current time), delivering every sample with time <= t_end_s not delivered yet.
  * HM_OK also when a callback stopped the run (then not to be resumed: samples of the last step are lost); the
- * integrator's error otherwise (the state and time stay where they were). */
+ * integrator's error otherwise (the state and time stay where they were), or the model's when a sample's
+ * acceleration could not be computed (HM_ENONFINITE: no sample is delivered for it). */
 hm_status hm_sensor_sim_run(hm_sensor_sim sim, double t_end_s, const hm_sensor_sink *sink);
 
 /* The current time [s] and true state (hm_sensor_sim_dim values). */

@@ -61,12 +61,14 @@ typedef struct {
   const int *state_body;         /* per state: its body (0..n_bodies-1), or -1 (a damper's internal state) */
   const double *state_inertia;   /* per state: the mass [kg] or inertia [kg m^2] of a velocity state, else 0 */
   const double *state_scale;     /* per state: a typical size (1e-3 m, 0.1 m/s, ...): the cycles' Newton scales */
-  size_t amp_state;              /* the state whose max |x| is a cycle's amplitude (the leading wheelset's y) */
+  size_t amp_state;              /* the state a cycle starts from at an extreme (the leading wheelset's y) */
   size_t phase_state;            /* its rate (x[amp_state]' = x[phase_state]): a cycle starts where it is 0 */
   int odd;                       /* 1 if f(-x) = -f(x) (lambda(y) even): symmetric cycles, half-period shooting */
   hm_system_track_fn rhs_track;  /* the right-hand side over a track */
   size_t n_wheelsets;            /* 1..HM_SYSTEM_MAX_WHEELSETS, leading first */
   const double *wheelset_x_m;    /* their longitudinal positions [m], decreasing (the leading one first) */
+  const size_t *wheelset_y_state; /* the state of each one's lateral displacement y (its rate the next state): a
+                                    cycle's amplitude is the largest |y| over them all */
 } hm_system;
 
 /* An accelerometer on a model: sum of weight[j] * dx[state[j]] [m/s^2] over velocity states (a lateral
@@ -122,6 +124,7 @@ hm_status hm_system_critical_speed(const hm_system *sys, const hm_system_critica
 typedef struct {
   hm_model model; /* the vehicle and its coefficients; the speed is given per call */
   double inertia[4], scale[4], x_m[1];
+  size_t y_state[1];
   int body[4];
 } hm_wheelset_system;
 

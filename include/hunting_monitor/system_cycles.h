@@ -31,7 +31,7 @@ extern "C" {
 
 typedef struct {
   double v_min_kmh, v_max_kmh; /* the Hopf search starts at v_min; continuation stops outside [v_min, v_max] */
-  double amp_max_m;            /* stop when the amplitude exceeds this [m] */
+  double amp_max_m;            /* stop when the amplitude (any wheelset's max |y|) exceeds this [m] */
   double amp_start_m;          /* the first cycle's amplitude near the Hopf point [m] */
   hm_shooting_options shoot;
   hm_cont_options cont;
@@ -44,7 +44,7 @@ typedef struct {
   size_t dim;
   double speed_kmh;
   double period_s;
-  double amp_m;                  /* max |x[amp_state]| over the cycle */
+  double amp_m;                  /* max |y| over the cycle and every wheelset (wheelset_y_state) */
   double x0[HM_SYSTEM_MAX_DIM];  /* the start point: x[phase_state] = 0 */
   double mult_re[HM_SYSTEM_MAX_DIM], mult_im[HM_SYSTEM_MAX_DIM]; /* Floquet multipliers, decreasing modulus */
   int trivial_index;             /* the trivial multiplier's index (closest to +1) */

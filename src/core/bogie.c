@@ -106,10 +106,12 @@ hm_status hm_bogie_model_init(hm_bogie_model *m, const hm_bogie *bogie, int fram
   memcpy(w.body, body, sizeof body);
   w.x_m[0] = bogie->half_wheelbase_m;
   w.x_m[1] = -bogie->half_wheelbase_m;
+  w.y_state[0] = 0;
+  w.y_state[1] = 4;
   *m = w;
   *sys = (hm_system){m->frame_held ? HM_BOGIE_HELD_DIM : HM_BOGIE_DIM, sys_rhs, sys_jac, sys_dfdv, m, 2,
                      BOGIE_BODIES, m->body, m->inertia, m->scale, 0, 1,
-                     hm_conicity_is_even(&bogie->wheelset.conicity, 1e-12), sys_rhs_track, 2, m->x_m};
+                     hm_conicity_is_even(&bogie->wheelset.conicity, 1e-12), sys_rhs_track, 2, m->x_m, m->y_state};
   return HM_OK;
 }
 

@@ -80,9 +80,10 @@ hm_status hm_car_model_init(hm_car_model *m, const hm_car *car, int carbody_held
   }
   const double a = car->half_bogie_distance_m, b = car->bogie.half_wheelbase_m;
   w.x_m[0] = a + b, w.x_m[1] = a - b, w.x_m[2] = -a + b, w.x_m[3] = -a - b;
+  w.y_state[0] = 0, w.y_state[1] = 4, w.y_state[2] = NB, w.y_state[3] = NB + 4;
   *m = w;
   *sys = (hm_system){m->carbody_held ? HM_CAR_HELD_DIM : HM_CAR_DIM, sys_rhs, sys_jac, sys_dfdv, m, 3, CAR_BODIES,
-                     m->body, m->inertia, m->scale, 0, 1, bogie_sys.odd, sys_rhs_track, 4, m->x_m};
+                     m->body, m->inertia, m->scale, 0, 1, bogie_sys.odd, sys_rhs_track, 4, m->x_m, m->y_state};
   return HM_OK;
 }
 

@@ -248,7 +248,7 @@ hm_status hm_lines_fit_sinusoid(const double *re, const double *im, size_t nbins
   }
   const double h = 0.005 * unit;
   double ew[21];
-  int ib = 10;
+  int ib = 0; /* the best so far among those computed (ew[10] is not yet when the first ten are compared) */
   for (int step = -10; step <= 10; ++step) {
     ew[step + 10] = line_at(re, im, k, m, n, nfft, best_w + step * h, &ar, &ai);
     if (ew[step + 10] > ew[ib]) ib = step + 10;

@@ -18,7 +18,9 @@ struct hm_mode_model_s {
   hm_system sys;
   double conicity;       /* the conicity the system holds (NAN: none yet) */
   hm_car given;          /* the parameters as created */
-  double grid_hopf_kmh[HM_MODE_MODEL_GRID]; /* the Hopf curve: NAN not computed yet, +inf none */
+  double band_lo_hz, band_hi_hz; /* the least-damped root is sought in this band */
+  double grid_hopf_kmh[HM_MODE_MODEL_GRID]; /* the Hopf curve: NAN not computed yet, +inf none, 0 unstable at all */
+  double grid_f_hz[HM_MODE_MODEL_GRID];     /* its critical mode's frequency */
 };
 
 static hm_status set_conicity(hm_mode_model m, double conicity) {
@@ -43,6 +45,8 @@ static hm_status create(hm_model_kind kind, const hm_car *params, hm_mode_model 
   m->kind = kind;
   m->params = *params;
   m->given = *params;
+  m->band_lo_hz = HM_MODE_MODEL_BAND_LOW_HZ;
+  m->band_hi_hz = HM_MODE_MODEL_BAND_HIGH_HZ;
   m->conicity = NAN;
   for (size_t i = 0; i < HM_MODE_MODEL_GRID; ++i) m->grid_hopf_kmh[i] = NAN;
   double l0;
@@ -95,7 +99,14 @@ hm_status hm_mode_model_create(hm_model_kind kind, const hm_car *params, hm_mode
   return HM_EINVAL;
 }
 
-hm_model_kind hm_mode_model_kind(const hm_mode_model m) { return m->kind; }
+hm_model_kind hm_mode_model_kind(const hm_mode_model m) { return m ? m->kind : HM_MODEL_WHEELSET; }
+
+hm_status hm_mode_model_set_band(hm_mode_model m, double low_hz, double high_hz) {
+  if (!m || !(low_hz >= 0.0) || !(high_hz > low_hz) || !isfinite(high_hz)) return HM_EINVAL;
+  m->band_lo_hz = low_hz;
+  m->band_hi_hz = high_hz;
+  return HM_OK;
+}
 
 void hm_mode_model_params(const hm_mode_model m, hm_car *params) {
   if (m && params) *params = m->given;
@@ -132,8 +143,9 @@ hm_status hm_mode_model_least_damped(hm_mode_model m, double conicity, double sp
   double re[NMAX], im[NMAX];
   if ((st = hm_system_eig(&m->sys, hm_mps_from_kmh(speed_kmh), re, im, NULL)) != HM_OK) return st;
   size_t k = m->sys.dim;
+  const double w_lo = 2.0 * HM_PI * m->band_lo_hz, w_hi = 2.0 * HM_PI * m->band_hi_hz;
   for (size_t i = 0; i < m->sys.dim; ++i)
-    if (im[i] > 0.0 && (k == m->sys.dim || re[i] > re[k])) k = i;
+    if (im[i] > 0.0 && im[i] >= w_lo && im[i] <= w_hi && (k == m->sys.dim || re[i] > re[k])) k = i;
   if (k == m->sys.dim) return HM_ENOCRIT;
   *sigma_1_s = re[k];
   *omega_rad_s = im[k];
@@ -145,11 +157,23 @@ static double grid_conicity(size_t i) {
          pow(HM_MODE_MODEL_LAMBDA_MAX / HM_MODE_MODEL_LAMBDA_MIN, (double)i / (double)(HM_MODE_MODEL_GRID - 1));
 }
 
-/* The curve's value at grid point i (computed now if not yet): the Hopf speed, +inf where none. */
+/* The curve's value at grid point i (computed now if not yet): the Hopf speed and its mode's frequency; +inf where
+ * the origin is stable at every speed, 0 where it is unstable already at HM_MODE_MODEL_V_MIN_KMH (never "none" for
+ * a vehicle that cannot run stably at all). */
 static double grid_hopf(hm_mode_model m, size_t i) {
   if (isnan(m->grid_hopf_kmh[i])) {
-    double v;
-    m->grid_hopf_kmh[i] = hm_mode_model_hopf(m, grid_conicity(i), &v, NULL, NULL) == HM_OK ? v : INFINITY;
+    double v, f = NAN;
+    const double l = grid_conicity(i);
+    if (hm_mode_model_hopf(m, l, &v, &f, NULL) != HM_OK) {
+      hm_system_spectrum s;
+      v = set_conicity(m, l) == HM_OK &&
+                  hm_system_spectrum_at(&m->sys, hm_mps_from_kmh(HM_MODE_MODEL_V_MIN_KMH), &s) == HM_OK &&
+                  s.abscissa_1_s >= 0.0
+              ? 0.0
+              : INFINITY;
+    }
+    m->grid_hopf_kmh[i] = v;
+    m->grid_f_hz[i] = f;
   }
   return m->grid_hopf_kmh[i];
 }
@@ -161,7 +185,14 @@ double hm_mode_model_hopf_kmh(hm_mode_model m, double conicity) {
   size_t i = (size_t)(u * (double)(HM_MODE_MODEL_GRID - 1));
   if (i >= HM_MODE_MODEL_GRID - 1) i = HM_MODE_MODEL_GRID - 2;
   const double v0 = grid_hopf(m, i), v1 = grid_hopf(m, i + 1);
-  if (!isfinite(v0) || !isfinite(v1)) return HM_LINEAR_NO_HOPF_KMH;
+  if (v0 == 0.0 || v1 == 0.0) return 0.0; /* unstable at every speed near there: the cautious reading */
+  /* where the critical mode changes between the grid points (the bogie's wheelsets' mode and its frame's near 0.28)
+   * the curve has a kink: the exact speed there instead of the interpolation (1.6 km/h off it) */
+  if (!isfinite(v0) || !isfinite(v1) || !(fabs(m->grid_f_hz[i] - m->grid_f_hz[i + 1]) <= HM_MODE_MODEL_KINK_HZ)) {
+    double v;
+    if (hm_mode_model_hopf(m, conicity, &v, NULL, NULL) == HM_OK) return fmin(v, HM_LINEAR_NO_HOPF_KMH);
+    return isfinite(v0) && isfinite(v1) ? fmin(v0, v1) : HM_LINEAR_NO_HOPF_KMH;
+  }
   const double l0 = grid_conicity(i), l1 = grid_conicity(i + 1), f = (conicity - l0) / (l1 - l0);
   const double q = (1.0 - f) / (v0 * v0) + f / (v1 * v1); /* 1/V^2 linear in the conicity */
   return fmin(1.0 / sqrt(q), HM_LINEAR_NO_HOPF_KMH);
@@ -189,8 +220,8 @@ hm_status hm_mode_model_hopf(hm_mode_model m, double conicity, double *speed_kmh
   if (!m || !speed_kmh || !isfinite(conicity) || conicity < 0.0) return HM_EDOMAIN;
   hm_status st = set_conicity(m, conicity);
   if (st != HM_OK) return st;
-  const hm_system_critical_options opt = {hm_mps_from_kmh(100.0), hm_mps_from_kmh(1500.0), hm_mps_from_kmh(5.0),
-                                          hm_mps_from_kmh(1e-6)};
+  const hm_system_critical_options opt = {hm_mps_from_kmh(HM_MODE_MODEL_V_MIN_KMH), hm_mps_from_kmh(1500.0),
+                                          hm_mps_from_kmh(5.0), hm_mps_from_kmh(1e-6)};
   double v;
   hm_system_spectrum s;
   if ((st = hm_system_critical_speed(&m->sys, &opt, &v, &s)) != HM_OK) return st;

@@ -153,6 +153,7 @@ hm_status hm_monitor_create_model(const hm_monitor_config *cfg, hm_model_kind ki
        : kind == HM_MODEL_BOGIE   ? hm_bogie_validate(&params->bogie, why, len)
        : kind == HM_MODEL_CAR     ? hm_car_validate(params, why, len)
                                   : HM_EINVAL;
+    if (st == HM_EINVAL && why && len) snprintf(why, len, "model: not a vehicle model the core holds (%d)", (int)kind);
   }
   if (st == HM_OK && kind != HM_MODEL_WHEELSET) st = hm_mode_model_create(kind, params, &model);
   if (st == HM_OK) st = ready_table(cfg, veh, kind, params, model, &table, pfor, runner, why, len);
@@ -175,8 +176,9 @@ hm_status hm_monitor_create_model(const hm_monitor_config *cfg, hm_model_kind ki
   if (st == HM_OK) st = hm_margin_create(&cfg->margin, veh, &m->margin, why, len);
   if (st == HM_OK) st = hm_alarm_create(&cfg->alarm, veh, table, &m->alarm, why, len);
   if (st == HM_OK && model) {
+    st = hm_mode_model_set_band(model, cfg->modal.band_low_hz, cfg->modal.band_high_hz);
     hm_margin_set_model(m->margin, model);
-    st = hm_alarm_set_model(m->alarm, model);
+    if (st == HM_OK) st = hm_alarm_set_model(m->alarm, model);
   }
   if (st == HM_OK) st = hm_track_lines_init(&m->lines, &cfg->track_lines, why, len);
   if (st != HM_OK) {
@@ -497,6 +499,16 @@ hm_status hm_monitor_replace_table(hm_monitor m, hm_table table, hm_table *repla
 
 hm_model_kind hm_monitor_model_kind(const hm_monitor m) {
   return m && m->model ? hm_mode_model_kind(m->model) : HM_MODEL_WHEELSET;
+}
+
+void hm_monitor_model_params(const hm_monitor m, hm_car *params) {
+  if (!m || !params) return;
+  if (m->model) {
+    hm_mode_model_params(m->model, params);
+  } else {
+    hm_car_default(params);
+    params->bogie.wheelset = m->veh;
+  }
 }
 
 void hm_monitor_vehicle(const hm_monitor m, hm_vehicle *veh) {

@@ -27,6 +27,7 @@ struct hm_sensor_sim_s {
   const hm_sensor_sink *sink;
   double t_end_s;
   int stopped;
+  hm_status failed;         /* a sample's acceleration could not be computed: the run stops with this status */
 };
 
 void hm_sensor_sim_config_default(hm_sensor_sim_config *cfg) {
@@ -187,7 +188,11 @@ static int deliver(hm_sensor_sim s, double t_hi, hm_status (*at)(void *, double,
     }
     double x[HM_SYSTEM_MAX_DIM], a = 0.0;
     if (at(at_ctx, ta, x) != HM_OK) return 1;
-    (void)true_accel(s, ta, x, &a);
+    const hm_status st = true_accel(s, ta, x, &a);
+    if (st != HM_OK || !isfinite(a)) { /* never a 0 for a sample that could not be computed */
+      s->failed = st != HM_OK ? st : HM_ENONFINITE;
+      return 1;
+    }
     const double noise = s->cfg.accel_noise_mps2 > 0.0 ? s->cfg.accel_noise_mps2 * hm_rng_gaussian(&s->rng) : 0.0;
     ++s->accel_k;
     if (k && k->accel && k->accel(k->ctx, ta, a + noise, a, x)) return 1;
@@ -227,8 +232,9 @@ hm_status hm_sensor_sim_run(hm_sensor_sim s, double t_end_s, const hm_sensor_sin
   s->sink = sink;
   s->t_end_s = t_end_s;
   s->stopped = 0;
+  s->failed = HM_OK;
   /* the samples due now (the first one at t = 0), from the current state */
-  if (deliver(s, s->t_s, state_at, s)) return HM_OK;
+  if (deliver(s, s->t_s, state_at, s)) return s->failed;
   if (t_end_s == s->t_s) return HM_OK;
   const hm_ode_system sys = s->generic ? (hm_ode_system){s->n, system_rhs, NULL, s}
                                        : (hm_ode_system){4, hm_excited_rhs, NULL, &s->em};
@@ -237,6 +243,7 @@ hm_status hm_sensor_sim_run(hm_sensor_sim s, double t_end_s, const hm_sensor_sin
   memcpy(x, s->x, s->n * sizeof(double));
   hm_status st = hm_dopri_integrate(s->integ, &sys, &opt, s->t_s, t_end_s, x, &t_reached, observer, s, NULL);
   if (st != HM_OK) return st;
+  if (s->failed != HM_OK) return s->failed;
   memcpy(s->x, x, s->n * sizeof(double));
   s->t_s = t_reached;
   return HM_OK;

@@ -126,7 +126,22 @@ static uint64_t monitor_hash(const hm_monitor m) {
   hm_vehicle veh;
   hm_monitor_settings(m, &cfg);
   hm_monitor_vehicle(m, &veh);
-  return hm_state_hash(&cfg, &veh);
+  uint64_t h = hm_state_hash(&cfg, &veh);
+  const hm_model_kind kind = hm_monitor_model_kind(m);
+  if (kind != HM_MODEL_WHEELSET) { /* a bogie's or car's state is theirs alone (the wheelset's hash as before) */
+    hm_car p;
+    hm_monitor_model_params(m, &p);
+    const hm_bogie *b = &p.bogie;
+    const double v[] = {b->frame_mass_kg, b->frame_yaw_inertia_kg_m2, b->half_wheelbase_m,
+                        b->secondary_lat_stiffness_n_m, b->secondary_lat_damping_n_s_m, b->airspring_long_stiffness_n_m,
+                        b->airspring_half_distance_m, b->yaw_damper_damping_n_s_m, b->yaw_damper_stiffness_n_m,
+                        b->yaw_damper_half_distance_m, p.carbody_mass_kg, p.carbody_yaw_inertia_kg_m2,
+                        p.half_bogie_distance_m};
+    h = fnv_u64(h, (uint64_t)kind);
+    for (size_t k = 0; k < sizeof v / sizeof v[0]; ++k)
+      if (kind == HM_MODEL_CAR || k < 10) h = fnv_f64(h, v[k]);
+  }
+  return h;
 }
 
 hm_status hm_state_save(const hm_monitor m, double now_s, double written_unix_s, unsigned char *buf, size_t cap,

@@ -36,10 +36,12 @@ hm_status hm_system_validate(const hm_system *sys) {
     if (!isfinite(sc) || !(sc > 0.0)) return HM_EINVAL;
     total += w;
   }
-  if (!sys->rhs_track || sys->n_wheelsets < 1 || sys->n_wheelsets > HM_SYSTEM_MAX_WHEELSETS || !sys->wheelset_x_m)
+  if (!sys->rhs_track || sys->n_wheelsets < 1 || sys->n_wheelsets > HM_SYSTEM_MAX_WHEELSETS || !sys->wheelset_x_m ||
+      !sys->wheelset_y_state)
     return HM_EINVAL;
   for (size_t i = 0; i < sys->n_wheelsets; ++i)
-    if (!isfinite(sys->wheelset_x_m[i]) || (i > 0 && !(sys->wheelset_x_m[i] < sys->wheelset_x_m[i - 1])))
+    if (!isfinite(sys->wheelset_x_m[i]) || (i > 0 && !(sys->wheelset_x_m[i] < sys->wheelset_x_m[i - 1])) ||
+        sys->wheelset_y_state[i] + 1 >= sys->dim)
       return HM_EINVAL;
   return total > 0.0 ? HM_OK : HM_EINVAL;
 }
@@ -223,8 +225,9 @@ hm_status hm_wheelset_system_init(hm_wheelset_system *ws, const hm_vehicle *veh,
   memcpy(w.scale, scale, sizeof scale);
   for (int i = 0; i < 4; ++i) w.body[i] = 0;
   w.x_m[0] = 0.0;
+  w.y_state[0] = 0;
   *ws = w;
   *sys = (hm_system){4, ws_rhs, ws_jac, ws_dfdv, ws, 1, WHEELSET_BODIES, ws->body, ws->inertia, ws->scale, 0, 1,
-                     hm_conicity_is_even(&veh->conicity, 1e-12), ws_rhs_track, 1, ws->x_m};
+                     hm_conicity_is_even(&veh->conicity, 1e-12), ws_rhs_track, 1, ws->x_m, ws->y_state};
   return HM_OK;
 }

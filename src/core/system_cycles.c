@@ -80,12 +80,21 @@ static hm_status aug_rhs(double t, const double *z, double *dz, void *ctx) {
   return HM_OK;
 }
 
+/* The cycle's amplitude: the largest |y| of every wheelset over each step (a car's trailing bogie may hunt alone). */
 static int amp_observer(double t_old, const double *x_old, const double *f_old, double t_new, const double *x_new,
                         const double *f_new, void *ctx) {
   shooter *c = (shooter *)ctx;
-  const size_t a = c->sys.amp_state, p = c->sys.phase_state;
-  c->amp = fmax(c->amp, hm_sh_extreme(t_new - t_old, x_old[a], x_old[p], f_old[p], x_new[a], x_new[p], f_new[p]));
+  for (size_t i = 0; i < c->sys.n_wheelsets; ++i) {
+    const size_t a = c->sys.wheelset_y_state[i], p = a + 1;
+    c->amp = fmax(c->amp, hm_sh_extreme(t_new - t_old, x_old[a], x_old[p], f_old[p], x_new[a], x_new[p], f_new[p]));
+  }
   return 0;
+}
+
+static double start_amplitude(const shooter *c, const double *x0) {
+  double amp = 0.0;
+  for (size_t i = 0; i < c->sys.n_wheelsets; ++i) amp = fmax(amp, fabs(x0[c->sys.wheelset_y_state[i]]));
+  return amp;
 }
 
 static void state_of(const shooter *c, const double *u, double *x0) {
@@ -103,7 +112,7 @@ static hm_status shoot_at(shooter *c, const double *u, shot *s) {
   memcpy(z, x0, n * sizeof(double));
   for (size_t i = 0; i < n; ++i) z[n + n * i + i] = 1.0;
   const double tau = c->symmetric ? 0.5 * T : T, sigma = c->symmetric ? -1.0 : 1.0;
-  c->amp = fabs(x0[c->sys.amp_state]);
+  c->amp = start_amplitude(c, x0);
   const hm_ode_system ode = {n + n * n + n, aug_rhs, NULL, c};
   const hm_dopri_options dopt = {c->shoot.rtol, c->shoot.atol, 0.0, 0.0, 0, n};
   hm_dopri_stats ds;

@@ -118,6 +118,38 @@ static void hopf_curve(void) {
   hm_mode_model_destroy(m);
 }
 
+/* Review of issue #28: a car's least-damped root is its hunting mode in the band, not the carbody's 0.6 Hz sway; the
+ * bogie's curve across the kink where its frame's mode takes over (near 0.283) is exact there; a conicity whose
+ * Hopf speed is below 100 km/h (1.7 for the bogie) has one, not "none". */
+static void band_kink_and_low_speeds(void) {
+  hm_car c;
+  hm_car_default(&c);
+  hm_bogie b;
+  hm_bogie_default(&b);
+  hm_mode_model car = NULL, m = NULL;
+  HM_CHECK(hm_mode_model_create_car(&c, &car) == HM_OK && hm_mode_model_create_bogie(&b, &m) == HM_OK, "create");
+  if (!car || !m) return;
+  double s = 0.0, w = 0.0, s_ref = 0.0, f_ref = 0.0;
+  HM_CHECK(hm_mode_model_least_damped(car, 0.1358, 400.0, &s, &w) == HM_OK, "least damped");
+  HM_CHECK(hm_mode_model_root(car, 0.1358, 400.0, -5.0, 5.0, 14.0, 2.0, &s_ref, &f_ref) == HM_OK, "14 Hz root");
+  printf("  car at 400 km/h: least damped in 2-30 Hz %.3f 1/s at %.2f Hz\n", s, w / (2.0 * HM_PI));
+  HM_CHECK(w / (2.0 * HM_PI) > 2.0, "in the band, not the carbody's sway");
+  HM_CHECK(s >= s_ref - 1e-12, "no less damped than the wheelsets' 14 Hz mode");
+  double worst = 0.0;
+  for (double l = 0.275; l <= 0.292; l += 0.0007) {
+    double v = 0.0;
+    HM_CHECK(hm_mode_model_hopf(m, l, &v, NULL, NULL) == HM_OK, "exact");
+    worst = fmax(worst, fabs(hm_mode_model_hopf_kmh(m, l) - v));
+  }
+  printf("  bogie curve across the kink (0.275-0.292): at most %.3g km/h off the exact speed\n", worst);
+  HM_CHECK(worst < 0.05, "the curve's stated error holds across the kink");
+  double v = 0.0;
+  HM_CHECK(hm_mode_model_hopf(m, 1.7, &v, NULL, NULL) == HM_OK && v < 100.0, "a Hopf speed below 100 km/h: %g", v);
+  HM_CHECK_DELTA(hm_mode_model_hopf_kmh(m, 1.7), v, 0.05, "and the curve gives it");
+  hm_mode_model_destroy(car);
+  hm_mode_model_destroy(m);
+}
+
 static void bad_input(void) {
   hm_vehicle veh;
   hm_vehicle_default(&veh);
@@ -136,6 +168,7 @@ static void bad_input(void) {
   double v = -1.0;
   HM_CHECK(hm_mode_model_hopf(m, -0.1, &v, NULL, NULL) == HM_EDOMAIN && v == -1.0, "negative conicity");
   HM_CHECK(hm_mode_model_hopf(m, 0.001, &v, NULL, NULL) == HM_ENOCRIT && v == -1.0, "no Hopf point in range");
+  HM_CHECK(hm_mode_model_kind(NULL) == HM_MODEL_WHEELSET, "a NULL model");
   hm_mode_model_destroy(m);
 }
 
@@ -143,6 +176,7 @@ int main(void) {
   HM_RUN(wheelset_as_inversion_h);
   HM_RUN(bogie_and_car_find_their_own_conicity);
   HM_RUN(hopf_curve);
+  HM_RUN(band_kink_and_low_speeds);
   HM_RUN(bad_input);
   HM_TEST_EXIT();
 }
