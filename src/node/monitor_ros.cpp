@@ -111,10 +111,11 @@ bool MonitorRos::loadParameters() {
   char err[512] = "";
   // vehicle, estimator and alarm sections go through the core's own YAML parsers
   std::string error;
-  if (!loadVehicleParams(pnh_, &vehicle_, &error)) {
+  if (!loadVehicleModelParams(pnh_, &kind_, &model_params_, &error)) {
     ROS_FATAL("hunting_monitor: %s", error.c_str());
     return false;
   }
+  vehicle_ = model_params_.bogie.wheelset;
   hm_monitor_config_default(&cfg_);
   const std::string monitor_yaml = sectionsAsYaml(pnh_, {"estimator", "modal", "margin", "track_lines", "alarm", "table"});
   if (hm_config_parse_monitor(monitor_yaml.c_str(), monitor_yaml.size(), "~ (monitor parameters)", &cfg_, err,
@@ -191,9 +192,15 @@ bool MonitorRos::loadParameters() {
     ROS_FATAL("hunting_monitor: ~table_file: %s", err);
     return false;
   }
+  if (kind_ != HM_MODEL_WHEELSET) {
+    // a bogie's or car's families come from its own engine; the background refinement computes the wheelset's
+    cfg_.table.refine = 0;
+    ROS_INFO("hunting_monitor: vehicle model %s (its modes, Hopf speeds and table; no background table refinement)",
+             hm_model_kind_name(kind_));
+  }
   hm_threads threads = {0};
-  const hm_status st =
-      hm_monitor_create_parallel(&cfg_, &vehicle_, table, hm_threads_parallel_for, &threads, &monitor_, err, sizeof err);
+  const hm_status st = hm_monitor_create_model(&cfg_, kind_, &model_params_, table, hm_threads_parallel_for, &threads,
+                                               &monitor_, err, sizeof err);
   if (st != HM_OK) {
     ROS_FATAL("hunting_monitor: %s%s: %s", table ? "~table_file " : "", table ? table_file_.c_str() : "",
               *err ? err : hm_status_str(st));

@@ -77,7 +77,9 @@ class MonitorRos {
   bool allow_reconfigure_ = false;  // ~allow_reconfigure: offer the alarm and criteria settings to dynamic_reconfigure
   std::string state_file_;          // ~state_file ("" disables; unset: under ROS_HOME, named after the node)
   double state_period_s_ = 2.0;     // ~state_period_s (wall time)
-  hm_vehicle vehicle_{};
+  hm_vehicle vehicle_{};            // the (leading) wheelset's parameters
+  hm_model_kind kind_ = HM_MODEL_WHEELSET;  // ~model: wheelset, bogie or car (issue #28)
+  hm_car model_params_{};           // the bogie's or car's parameters (the wheelset's in .bogie.wheelset)
   hm_monitor_config cfg_{};
   // the core's monitor (estimator, identification, margin, alarm, table)
   hm_monitor monitor_ = nullptr;
