@@ -38,6 +38,10 @@ hm_status hm_track_create(double wavelength_min_m, double wavelength_max_m, doub
 void hm_track_destroy(hm_track track);
 /* y_t [m] at distance s [m] (the track repeats every 26.2 km). */
 double hm_track_at(const hm_track track, double s_m);
+/* The alignment spectrum's shape S(W) [m^2 / (rad/m)] at wavenumber W [rad/m] (scale 1): the German high-speed one
+ * for low disturbance, A Wc^2 / ((W^2 + Wr^2)(W^2 + Wc^2)). */
+double hm_track_alignment_psd(double wavenumber_rad_m);
+
 /* Its r.m.s. [m] and the one the spectrum gives over the band (they agree to the sampling of the amplitudes). */
 double hm_track_rms_m(const hm_track track);
 double hm_track_spectrum_rms_m(double wavelength_min_m, double wavelength_max_m, double scale);

@@ -90,6 +90,32 @@ hm_status hm_mode_model_hopf(hm_mode_model m, double conicity, double *speed_kmh
 hm_status hm_mode_model_invert(hm_mode_model m, double speed_kmh, double sigma_m, double e_sigma, double f_m,
                                double e_f, double tol, unsigned max_iter, hm_conicity_inversion *out);
 
+/* ---- the spectrum the model predicts at a sensor (a prototype of the reading for a model, issue #28) ----
+ * The linearised model driven by the track's alignment under each wheelset (the trailing ones (x_0 - x_i) / v later)
+ * through its right-hand side over a track (the derivative by one-sided differences of 1e-7 m), the track's spectrum
+ * the German low-disturbance one (excitation.h); the acceleration at the point: its transfer function H(w) by a complex
+ * solve (zgesv) per frequency; the shape |H(w)|^2 S(w / v) / v [(m/s^2)^2 / Hz, up to a constant factor]. */
+
+/* Where an accelerometer sits on the model: "axlebox" (any model), "frame", "carbody" (bogie.h, car.h). */
+hm_status hm_mode_model_sensor(hm_mode_model m, const char *where, hm_sensor_point *out);
+
+/* The shape at n frequencies f_hz[] (> 0) for the conicity and speed into shape[]. */
+hm_status hm_mode_model_sensor_spectrum(hm_mode_model m, double conicity, double speed_kmh,
+                                        const hm_sensor_point *point, const double *f_hz, size_t n, double *shape);
+
+typedef struct {
+  double conicity, conicity_se;  /* the likelihood's minimum and its curvature's error */
+  double amplitude, noise;       /* the shape's factor and the white floor [(m/s^2)^2 / Hz] */
+  double neg2_log_lik;           /* -2 log L at the minimum (up to a constant) */
+} hm_spectrum_fit;
+
+/* The conicity whose predicted spectrum a psd + n explains best: the Whittle likelihood of a measured spectrum psd[]
+ * at f_hz[] (each bin the mean of dof / 2 independent periodograms), amplitude a and floor n profiled out (a grid of
+ * 30 floors, Newton on a), over [lo, hi]: a geometric scan of 24 conicities, then golden section to tol. */
+hm_status hm_mode_model_fit_spectrum(hm_mode_model m, double speed_kmh, const hm_sensor_point *point,
+                                     const double *f_hz, const double *psd, size_t n, double dof, double lo,
+                                     double hi, double tol, hm_spectrum_fit *out);
+
 #ifdef __cplusplus
 }
 #endif

@@ -10,7 +10,7 @@
 #include "rng.h"
 
 /* German high-speed alignment spectrum, low disturbance: S(W) = A Wc^2 / ((W^2 + Wr^2)(W^2 + Wc^2)). */
-static double alignment_psd(double w) {
+double hm_track_alignment_psd(double w) {
   const double A = 2.119e-7, wc = 0.8246, wr = 0.0206;
   return A * wc * wc / ((w * w + wr * wr) * (w * w + wc * wc));
 }
@@ -59,7 +59,7 @@ hm_status hm_track_create(double wl_min, double wl_max, double scale, uint64_t s
   for (size_t k = 1; k < n / 2; ++k) {
     const double w = dw * (double)k;
     if (w < 2.0 * HM_PI / wl_max || w > 2.0 * HM_PI / wl_min) continue;
-    const double c = sqrt(scale * alignment_psd(w) * dw) / 2.0;
+    const double c = sqrt(scale * hm_track_alignment_psd(w) * dw) / 2.0;
     re[k] = 2.0 * c * hm_rng_gaussian(&rng);
     im[k] = -2.0 * c * hm_rng_gaussian(&rng); /* conjugated for the inverse */
   }

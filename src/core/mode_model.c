@@ -5,7 +5,9 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "hunting_monitor/excitation.h"
 #include "hunting_monitor/linear.h"
+#include "lapack.h"
 
 enum { NMAX = HM_SYSTEM_MAX_DIM };
 
@@ -295,4 +297,154 @@ hm_status hm_mode_model_invert(hm_mode_model m, double speed_kmh, double sigma_m
     return HM_OK;
   }
   return HM_ENOCONV;
+}
+
+/* ---- the spectrum at a sensor ---- */
+
+hm_status hm_mode_model_sensor(hm_mode_model m, const char *where, hm_sensor_point *out) {
+  if (!m || !where || !out) return HM_EINVAL;
+  switch (m->kind) {
+    case HM_MODEL_BOGIE: return hm_bogie_sensor(&m->bogie, where, out);
+    case HM_MODEL_CAR: return hm_car_sensor(&m->car, where, out);
+    default:
+      if (strcmp(where, "axlebox") != 0) return HM_EINVAL;
+      *out = (hm_sensor_point){1, {1, 0, 0, 0}, {1.0, 0.0, 0.0, 0.0}};
+      return HM_OK;
+  }
+}
+
+hm_status hm_mode_model_sensor_spectrum(hm_mode_model m, double conicity, double speed_kmh,
+                                        const hm_sensor_point *point, const double *f_hz, size_t n, double *shape) {
+  if (!m || !point || !f_hz || !shape || n == 0 || !(speed_kmh > 0.0) || !isfinite(speed_kmh) ||
+      !isfinite(conicity) || conicity < 0.0)
+    return HM_EDOMAIN;
+  hm_status st = set_conicity(m, conicity);
+  if (st != HM_OK) return st;
+  const hm_system *sys = &m->sys;
+  if (!hm_sensor_point_valid(sys, point)) return HM_EINVAL;
+  const size_t d = sys->dim, nw = sys->n_wheelsets;
+  const double v = hm_mps_from_kmh(speed_kmh), h = 1e-7;
+  double jac[NMAX * NMAX], x0[NMAX] = {0.0}, f0[NMAX], f1[NMAX], B[HM_SYSTEM_MAX_WHEELSETS][NMAX];
+  double yt[HM_SYSTEM_MAX_WHEELSETS] = {0.0};
+  if ((st = sys->jacobian(sys->model, v, x0, jac)) != HM_OK) return st;
+  if ((st = sys->rhs_track(sys->model, v, x0, yt, f0)) != HM_OK) return st;
+  for (size_t i = 0; i < nw; ++i) { /* d f / d y_track_i: linear in the track at the origin */
+    yt[i] = h;
+    st = sys->rhs_track(sys->model, v, x0, yt, f1);
+    yt[i] = 0.0;
+    if (st != HM_OK) return st;
+    for (size_t r = 0; r < d; ++r) B[i][r] = (f1[r] - f0[r]) / h;
+  }
+  for (size_t k = 0; k < n; ++k) {
+    const double w = 2.0 * HM_PI * f_hz[k];
+    if (!(w > 0.0) || !isfinite(w)) return HM_EDOMAIN;
+    double _Complex a[NMAX * NMAX], u[NMAX];
+    for (size_t r = 0; r < d; ++r) {
+      u[r] = 0.0;
+      for (size_t c = 0; c < d; ++c) a[r + d * c] = (r == c ? I * w : 0.0) - jac[d * r + c]; /* column-major */
+    }
+    double _Complex ua[HM_SYSTEM_MAX_WHEELSETS];
+    for (size_t i = 0; i < nw; ++i) {
+      ua[i] = cexp(-I * w * (sys->wheelset_x_m[0] - sys->wheelset_x_m[i]) / v);
+      for (size_t r = 0; r < d; ++r) u[r] += B[i][r] * ua[i];
+    }
+    double _Complex x[NMAX];
+    memcpy(x, u, d * sizeof x[0]);
+    int ipiv[NMAX], info = 0;
+    const int nn = (int)d, one = 1;
+    zgesv_(&nn, &one, a, &nn, ipiv, x, &nn, &info);
+    if (info != 0) return HM_ELAPACK;
+    double _Complex acc = 0.0; /* the point's sum of accelerations: rows of i w X (= A X + B u) */
+    for (size_t j = 0; j < point->n_terms; ++j) acc += point->weight[j] * I * w * x[point->state[j]];
+    const double S = hm_track_alignment_psd(w / v) / v;
+    shape[k] = creal(acc * conj(acc)) * S;
+    if (!isfinite(shape[k])) return HM_ENONFINITE;
+  }
+  return HM_OK;
+}
+
+/* -sum log-likelihood (Whittle, per bin, up to a constant) with the amplitude and floor profiled out. */
+static double whittle_profile(const double *g, const double *p, size_t n, double *amp, double *floor_) {
+  double pmin = INFINITY, pmax = 0.0, gmean = 0.0, pmean = 0.0;
+  for (size_t k = 0; k < n; ++k) pmin = fmin(pmin, p[k]), pmax = fmax(pmax, p[k]), gmean += g[k], pmean += p[k];
+  gmean /= (double)n, pmean /= (double)n;
+  double best = INFINITY;
+  for (int j = 0; j < 30; ++j) {
+    const double fl = 0.01 * pmin * pow(50.0 * pmax / (0.01 * pmin), j / 29.0);
+    double a = fmax((pmean - fl) / gmean, 1e-300);
+    for (int it = 0; it < 30; ++it) { /* Newton on the amplitude */
+      double gr = 0.0, he = 0.0;
+      for (size_t k = 0; k < n; ++k) {
+        const double mk = a * g[k] + fl;
+        gr += g[k] / mk - p[k] * g[k] / (mk * mk);
+        he += -g[k] * g[k] / (mk * mk) + 2.0 * p[k] * g[k] * g[k] / (mk * mk * mk);
+      }
+      a = he > 0.0 ? fmax(a - gr / he, 0.1 * a) : 0.5 * a;
+    }
+    double l = 0.0;
+    for (size_t k = 0; k < n; ++k) {
+      const double mk = a * g[k] + fl;
+      l += p[k] / mk + log(mk);
+    }
+    if (l < best) best = l, *amp = a, *floor_ = fl;
+  }
+  return best;
+}
+
+typedef struct {
+  hm_mode_model m;
+  double v_kmh;
+  const hm_sensor_point *point;
+  const double *f, *p;
+  size_t n;
+  double *g;
+  double amp, floor_;
+} fit_ctx;
+
+static double fit_objective(fit_ctx *c, double lambda) {
+  if (hm_mode_model_sensor_spectrum(c->m, lambda, c->v_kmh, c->point, c->f, c->n, c->g) != HM_OK) return INFINITY;
+  return whittle_profile(c->g, c->p, c->n, &c->amp, &c->floor_);
+}
+
+hm_status hm_mode_model_fit_spectrum(hm_mode_model m, double speed_kmh, const hm_sensor_point *point,
+                                     const double *f_hz, const double *psd, size_t n, double dof, double lo,
+                                     double hi, double tol, hm_spectrum_fit *out) {
+  if (!m || !point || !f_hz || !psd || !out || n < 8 || n > 4096 || !(dof >= 2.0) || !(lo > 0.0) || !(hi > lo) ||
+      !isfinite(hi) || !(tol > 0.0))
+    return HM_EDOMAIN;
+  for (size_t k = 0; k < n; ++k)
+    if (!(psd[k] > 0.0) || !isfinite(psd[k])) return HM_EDOMAIN;
+  double g[4096];
+  fit_ctx c = {m, speed_kmh, point, f_hz, psd, n, g, 0.0, 0.0};
+  enum { SCAN = 24 };
+  double best = INFINITY;
+  int kb = -1;
+  double lv[SCAN], ov[SCAN];
+  for (int k = 0; k < SCAN; ++k) {
+    lv[k] = lo * pow(hi / lo, (double)k / (SCAN - 1));
+    ov[k] = fit_objective(&c, lv[k]);
+    if (ov[k] < best) best = ov[k], kb = k;
+  }
+  if (kb < 0) return HM_ENOCONV;
+  /* golden section in log lambda over the best scan point's neighbours */
+  double a = log(lv[kb > 0 ? kb - 1 : 0]), b = log(lv[kb < SCAN - 1 ? kb + 1 : SCAN - 1]);
+  const double r = 0.5 * (sqrt(5.0) - 1.0);
+  double x1 = b - r * (b - a), x2 = a + r * (b - a), f1 = fit_objective(&c, exp(x1)), f2 = fit_objective(&c, exp(x2));
+  for (int it = 0; it < 200 && exp(b) - exp(a) > tol; ++it) {
+    if (f1 < f2) b = x2, x2 = x1, f2 = f1, x1 = b - r * (b - a), f1 = fit_objective(&c, exp(x1));
+    else a = x1, x1 = x2, f1 = f2, x2 = a + r * (b - a), f2 = fit_objective(&c, exp(x2));
+  }
+  const double lam = exp(0.5 * (a + b));
+  const double l0 = fit_objective(&c, lam);
+  const double amp = c.amp, fl = c.floor_;
+  /* the curvature of -2 log L = dof * sum(...) at the minimum: its standard error */
+  const double dl = 0.01 * lam, lp = fit_objective(&c, lam + dl), lm = fit_objective(&c, lam - dl);
+  const double curv = dof * (lp - 2.0 * l0 + lm) / (dl * dl);
+  if (!isfinite(l0)) return HM_ENOCONV;
+  out->conicity = lam;
+  out->conicity_se = curv > 0.0 ? sqrt(2.0 / curv) : INFINITY;
+  out->amplitude = amp;
+  out->noise = fl;
+  out->neg2_log_lik = dof * l0;
+  return HM_OK;
 }
