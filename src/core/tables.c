@@ -258,6 +258,30 @@ static size_t decimate(tpoint *p, size_t n) {
   return kept;
 }
 
+/* The polyline of a family: the Hopf point (amplitude 0), then the branch br[0..np) with its located folds
+ * folds[0..nf) (each between branch points fold_index - 1 and fold_index, in order) as vertices (a fold between two
+ * points is the branch's extreme there; flagged stable, each segment beside it takes the stability of its other end),
+ * decimated into tp (room for np + nf + 1 points; shrunk, and owned by the curve); the lowest speed over the Hopf
+ * point, the branch and its folds. */
+static void family_curve(double conicity, double hopf_kmh, double l1, const tpoint *br, size_t np,
+                         const tpoint *folds, const size_t *fold_index, size_t nf, tpoint *tp, tcurve *out) {
+  double lowest = hopf_kmh;
+  size_t m = 0, k = 0;
+  tp[m++] = (tpoint){hopf_kmh, 0.0, br[0].stable};
+  for (size_t i = 0; i < np; ++i) {
+    for (; k < nf && fold_index[k] <= i; ++k)
+      if (fold_index[k] == i && i > 0) {
+        tp[m++] = folds[k];
+        lowest = fmin(lowest, folds[k].v_kmh);
+      }
+    tp[m++] = br[i];
+    lowest = fmin(lowest, br[i].v_kmh);
+  }
+  const size_t kept = decimate(tp, m);
+  tpoint *shrunk = realloc(tp, kept * sizeof *tp);
+  *out = (tcurve){conicity, hopf_kmh, l1, lowest, kept, shrunk ? shrunk : tp};
+}
+
 static hm_status curve_at(const hm_vehicle *veh, const hm_table_spec *spec, double conicity, tcurve *out) {
   hm_vehicle v = *veh;
   hm_status st = hm_vehicle_set_conicity_at_zero(&v, conicity);
@@ -278,56 +302,23 @@ static hm_status curve_at(const hm_vehicle *veh, const hm_table_spec *spec, doub
   const size_t CAP = o.cont.max_steps + 2;
   hm_cycle_point *pts = malloc(CAP * sizeof *pts);
   enum { MAX_EV = 64 };
-  tpoint *tp = malloc((CAP + MAX_EV + 1) * sizeof *tp);
+  tpoint *tp = malloc((CAP + MAX_EV + 1) * sizeof *tp), *br = malloc(CAP * sizeof *br), folds[MAX_EV];
   hm_cycle_event ev[MAX_EV];
-  size_t np = 0, ne = 0;
-  if (!pts || !tp) st = HM_ENOMEM;
+  size_t np = 0, ne = 0, nf = 0, fold_index[MAX_EV];
+  if (!pts || !tp || !br) st = HM_ENOMEM;
   if (st == HM_OK) st = hm_cycles_continue(&v, 500.0, &h, &o, pts, CAP, &np, ev, MAX_EV, &ne, NULL);
   if (st == HM_OK && np > 0) {
-    const double lowest = fmin(h.speed_kmh, hm_cycles_lowest(pts, np, ev, ne));
-    /* the polyline: the Hopf point itself (amplitude 0), then the branch with its located folds as vertices (a
-     * fold between two points is the branch's extreme there; flagged stable, each segment beside it takes the
-     * stability of its other end) */
-    size_t m = 0, k = 0;
-    tp[m++] = (tpoint){h.speed_kmh, 0.0, pts[0].stable};
-    for (size_t i = 0; i < np; ++i) {
-      for (; k < ne; ++k) {
-        if (ev[k].index > i) break;
-        if (ev[k].kind == HM_CYCLE_LPC && ev[k].index == i && i > 0)
-          tp[m++] = (tpoint){ev[k].point.param, ev[k].point.amp_y_m, 1};
-      }
-      tp[m++] = (tpoint){pts[i].param, pts[i].amp_y_m, pts[i].stable};
-    }
-    const size_t kept = decimate(tp, m);
-    tpoint *shrunk = realloc(tp, kept * sizeof *tp);
-    if (shrunk) tp = shrunk;
-    *out = (tcurve){conicity, h.speed_kmh, h.l1, lowest, kept, tp};
+    for (size_t i = 0; i < np; ++i) br[i] = (tpoint){pts[i].param, pts[i].amp_y_m, pts[i].stable};
+    for (size_t k = 0; k < ne; ++k)
+      if (ev[k].kind == HM_CYCLE_LPC)
+        fold_index[nf] = ev[k].index, folds[nf++] = (tpoint){ev[k].point.param, ev[k].point.amp_y_m, 1};
+    family_curve(conicity, h.speed_kmh, h.l1, br, np, folds, fold_index, nf, tp, out);
     tp = NULL;
   }
   free(pts);
+  free(br);
   free(tp);
   return st;
-}
-
-/* The polyline of a family: the Hopf point (amplitude 0), then the branch with its located folds as vertices (a fold
- * between two points is the branch's extreme there; flagged stable, each segment beside it takes the stability of its
- * other end), decimated; the table's curve at the conicity. Takes tp (m points' room at least np + ne + 1). */
-static void family_curve(double conicity, double hopf_kmh, double l1, const double *pv, const double *pa,
-                         const int *ps, size_t np, const size_t *ev_index, const double *ev_v, const double *ev_a,
-                         size_t ne, tpoint *tp, tcurve *out) {
-  double lowest = hopf_kmh;
-  size_t m = 0, k = 0;
-  tp[m++] = (tpoint){hopf_kmh, 0.0, ps[0]};
-  for (size_t i = 0; i < np; ++i) {
-    for (; k < ne && ev_index[k] <= i; ++k)
-      if (ev_index[k] == i && i > 0) {
-        tp[m++] = (tpoint){ev_v[k], ev_a[k], 1};
-        lowest = fmin(lowest, ev_v[k]);
-      }
-    tp[m++] = (tpoint){pv[i], pa[i], ps[i]};
-    lowest = fmin(lowest, pv[i]);
-  }
-  *out = (tcurve){conicity, hopf_kmh, l1, lowest, decimate(tp, m), tp};
 }
 
 /* A bogie's or car's curve at a conicity: its critical speed (the first crossing from 100 km/h) and its family of
@@ -358,29 +349,25 @@ static hm_status curve_at_model(hm_model_kind kind, const hm_car *params, const 
   const size_t CAP = o.cont.max_steps + 2;
   enum { MAX_EV = 64 };
   hm_system_cycle_point *pts = malloc(CAP * sizeof *pts);
-  double *pv = malloc(CAP * sizeof *pv), *pa = malloc(CAP * sizeof *pa);
-  int *ps = malloc(CAP * sizeof *ps);
-  tpoint *tp = malloc((CAP + MAX_EV + 1) * sizeof *tp);
+  tpoint *tp = malloc((CAP + MAX_EV + 1) * sizeof *tp), *br = malloc(CAP * sizeof *br), folds[MAX_EV];
   hm_system_cycle_event ev[MAX_EV];
-  size_t np = 0, ne = 0, ev_index[MAX_EV];
-  double ev_v[MAX_EV], ev_a[MAX_EV];
-  if (!pts || !pv || !pa || !ps || !tp) st = HM_ENOMEM;
+  size_t np = 0, ne = 0, nf = 0, fold_index[MAX_EV];
+  if (!pts || !tp || !br) st = HM_ENOMEM;
   if (st == HM_OK) st = hm_system_cycles_continue(&sys, &o, pts, CAP, &np, ev, MAX_EV, &ne, NULL);
   if (st == HM_OK && np > 1) {
-    size_t nl = 0;
-    for (size_t i = 0; i < np; ++i) pv[i] = pts[i].speed_kmh, pa[i] = pts[i].amp_m, ps[i] = pts[i].stable;
+    for (size_t i = 0; i < np; ++i) br[i] = (tpoint){pts[i].speed_kmh, pts[i].amp_m, pts[i].stable};
     for (size_t k = 0; k < ne; ++k)
-      if (ev[k].kind == HM_CYCLE_LPC) ev_index[nl] = ev[k].index, ev_v[nl] = ev[k].point.speed_kmh,
-                                      ev_a[nl++] = ev[k].point.amp_m;
+      if (ev[k].kind == HM_CYCLE_LPC)
+        fold_index[nf] = ev[k].index, folds[nf++] = (tpoint){ev[k].point.speed_kmh, ev[k].point.amp_m, 1};
     const double l1 = pts[1].speed_kmh < pts[0].speed_kmh ? 1.0 : -1.0;
-    family_curve(conicity, vh, l1, pv, pa, ps, np, ev_index, ev_v, ev_a, nl, tp, out);
-    tpoint *shrunk = realloc(out->pts, out->n * sizeof *tp);
-    if (shrunk) out->pts = shrunk;
+    family_curve(conicity, vh, l1, br, np, folds, fold_index, nf, tp, out);
     tp = NULL;
   } else if (st == HM_OK) {
     st = HM_ENOCONV;
   }
-  free(pts), free(pv), free(pa), free(ps), free(tp);
+  free(pts);
+  free(br);
+  free(tp);
   return st;
 }
 
