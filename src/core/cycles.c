@@ -2,6 +2,7 @@
 #include "hunting_monitor/cycles.h"
 
 #include <math.h>
+#include <stddef.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -70,6 +71,7 @@ static hm_status fill_node(const hm_sh *c, const hm_shot *s, const double *u, co
   out.pub.stable = out.pub.n_unstable == 0;
   out.pub.dparam_ds = t[4];
   out.tests.dparam_ds = t[4];
+  out.tests.amp_m = s->amp_y;
   memcpy(out.head.t, t, NU * sizeof(double));
   memcpy(out.head.u, u, NU * sizeof(double));
   *nd = out;
@@ -95,34 +97,18 @@ static hm_status cyc_finish(void *ctx, const double *u, const double *t, void *n
 
 /* ---- event location ---- */
 
-static double test_fn(const void *nd, void *kind) {
-  return hm_cycle_test_value(&((const node *)nd)->tests, *(hm_cycle_event_kind *)kind);
+static void emit_event(void *ctx, hm_cycle_event_kind kind, const void *located, int stable_side) {
+  cyc *y = (cyc *)ctx;
+  const hm_cycle_event ev = {kind, y->np, ((const node *)located)->pub, stable_side};
+  if (y->ne < y->max_events) y->events[y->ne] = ev;
+  ++y->ne;
 }
 
 /* Detect and locate the events between consecutive nodes a and b (b reached from a with step ds). */
 static void detect_events(cyc *y, const node *a, const node *b, double ds) {
-  int flags[4];
-  hm_cycle_event_flags(&a->tests, &b->tests, y->sh.symmetric, flags);
-  for (int k = 0; k < 4; ++k) {
-    if (!flags[k]) continue;
-    hm_cycle_event_kind kind = (hm_cycle_event_kind)k;
-    node located;
-    if (hm_cont_locate(&y->prob, &y->opt->cont, a, b, ds, hm_cycle_test_value(&a->tests, kind),
-                       hm_cycle_test_value(&b->tests, kind), test_fn, &kind, &located) != HM_OK)
-      continue;
-    if (k == HM_CYCLE_NS && fabs(located.tests.ns) > 1e-4) continue; /* not a crossing */
-    hm_cycle_event ev;
-    ev.kind = kind;
-    ev.index = y->np;
-    ev.point = located.pub;
-    ev.stable_side = 0;
-    if (k == HM_CYCLE_LPC) {
-      const node *upper = a->pub.amp_y_m > b->pub.amp_y_m ? a : b, *lower = upper == a ? b : a;
-      ev.stable_side = upper->pub.stable ? 1 : lower->pub.stable ? -1 : 0;
-    }
-    if (y->ne < y->max_events) y->events[y->ne] = ev;
-    ++y->ne;
-  }
+  node located;
+  hm_cycle_events_between(&y->prob, &y->opt->cont, a, b, ds, offsetof(node, tests), y->sh.symmetric, &located,
+                          emit_event, y);
 }
 
 static void store(cyc *y, const node *nd) {

@@ -45,7 +45,7 @@ hm_status hm_floquet(size_t n, const double *phi, int symmetric, double *mult_re
       order[j] = order[j - 1];
       order[j - 1] = tmp;
     }
-  hm_cycle_tests t = {0.0, bpc, 1.0, -INFINITY, 0};
+  hm_cycle_tests t = {0.0, bpc, 1.0, -INFINITY, 0, 0.0, 0};
   int unstable = 0, triv = 0;
   for (size_t k = 0; k < n; ++k) {
     const size_t i = order[k];
@@ -64,6 +64,7 @@ hm_status hm_floquet(size_t n, const double *phi, int symmetric, double *mult_re
   }
   *trivial_index = triv;
   *n_unstable = unstable;
+  t.stable = unstable == 0;
   *tests = t;
   return HM_OK;
 }
@@ -85,4 +86,41 @@ void hm_cycle_event_flags(const hm_cycle_tests *a, const hm_cycle_tests *b, int 
   flags[HM_CYCLE_BPC] = sign_change(a->bpc, b->bpc) && (symmetric || !flags[HM_CYCLE_LPC]);
   flags[HM_CYCLE_PD] = sign_change(a->pd, b->pd);
   flags[HM_CYCLE_NS] = a->ns_count != b->ns_count && a->ns > -INFINITY && b->ns > -INFINITY;
+}
+
+typedef struct {
+  hm_cycle_event_kind kind;
+  size_t offset;
+} test_of;
+
+static const hm_cycle_tests *tests_at(const void *node, size_t offset) {
+  return (const hm_cycle_tests *)((const char *)node + offset);
+}
+
+static double located_test(const void *node, void *arg) {
+  const test_of *t = (const test_of *)arg;
+  return hm_cycle_test_value(tests_at(node, t->offset), t->kind);
+}
+
+void hm_cycle_events_between(hm_cont_problem *p, const hm_cont_options *o, const void *a, const void *b, double ds,
+                             size_t tests_offset, int symmetric, void *scratch,
+                             void (*emit)(void *ctx, hm_cycle_event_kind kind, const void *located, int stable_side),
+                             void *ctx) {
+  const hm_cycle_tests *ta = tests_at(a, tests_offset), *tb = tests_at(b, tests_offset);
+  int flags[4];
+  hm_cycle_event_flags(ta, tb, symmetric, flags);
+  for (int k = 0; k < 4; ++k) {
+    if (!flags[k]) continue;
+    test_of t = {(hm_cycle_event_kind)k, tests_offset};
+    if (hm_cont_locate(p, o, a, b, ds, hm_cycle_test_value(ta, t.kind), hm_cycle_test_value(tb, t.kind), located_test,
+                       &t, scratch) != HM_OK)
+      continue;
+    if (k == HM_CYCLE_NS && fabs(tests_at(scratch, tests_offset)->ns) > 1e-4) continue; /* not a crossing */
+    int side = 0;
+    if (k == HM_CYCLE_LPC) {
+      const hm_cycle_tests *upper = ta->amp_m > tb->amp_m ? ta : tb, *lower = upper == ta ? tb : ta;
+      side = upper->stable ? 1 : lower->stable ? -1 : 0;
+    }
+    emit(ctx, t.kind, scratch, side);
+  }
 }

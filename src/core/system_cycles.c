@@ -3,6 +3,7 @@
 #include "hunting_monitor/system_cycles.h"
 
 #include <math.h>
+#include <stddef.h>
 #include <string.h>
 
 #include "hunting_monitor/integrate.h"
@@ -189,6 +190,7 @@ static hm_status fill_node(const shooter *c, const shot *s, const double *u, con
   out.pub.stable = out.pub.n_unstable == 0;
   out.pub.dspeed_ds = t[n];
   out.tests.dparam_ds = t[n];
+  out.tests.amp_m = s->amp;
   memcpy(out.head.t, t, c->nu * sizeof(double));
   memcpy(out.head.u, u, c->nu * sizeof(double));
   *nd = out;
@@ -216,29 +218,17 @@ static hm_status fam_finish(void *ctx, const double *u, const double *t, void *n
 
 /* ---- events ---- */
 
-static double test_fn(const void *nd, void *kind) {
-  return hm_cycle_test_value(&((const node *)nd)->tests, *(hm_cycle_event_kind *)kind);
+static void emit_event(void *ctx, hm_cycle_event_kind kind, const void *located, int stable_side) {
+  family *y = (family *)ctx;
+  const hm_system_cycle_event ev = {kind, y->np, ((const node *)located)->pub, stable_side};
+  if (y->ne < y->max_events) y->events[y->ne] = ev;
+  ++y->ne;
 }
 
 static void detect_events(family *y, const node *a, const node *b, double ds) {
-  int flags[4];
-  hm_cycle_event_flags(&a->tests, &b->tests, y->sh.symmetric, flags);
-  for (int k = 0; k < 4; ++k) {
-    if (!flags[k]) continue;
-    hm_cycle_event_kind kind = (hm_cycle_event_kind)k;
-    node located;
-    if (hm_cont_locate(&y->prob, &y->opt->cont, a, b, ds, hm_cycle_test_value(&a->tests, kind),
-                       hm_cycle_test_value(&b->tests, kind), test_fn, &kind, &located) != HM_OK)
-      continue;
-    if (k == HM_CYCLE_NS && fabs(located.tests.ns) > 1e-4) continue; /* not a crossing */
-    hm_system_cycle_event ev = {kind, y->np, located.pub, 0};
-    if (k == HM_CYCLE_LPC) {
-      const node *upper = a->pub.amp_m > b->pub.amp_m ? a : b, *lower = upper == a ? b : a;
-      ev.stable_side = upper->pub.stable ? 1 : lower->pub.stable ? -1 : 0;
-    }
-    if (y->ne < y->max_events) y->events[y->ne] = ev;
-    ++y->ne;
-  }
+  node located;
+  hm_cycle_events_between(&y->prob, &y->opt->cont, a, b, ds, offsetof(node, tests), y->sh.symmetric, &located,
+                          emit_event, y);
 }
 
 static void store(family *y, const node *nd) {
