@@ -286,6 +286,27 @@ static int cycle_options(const cli_args *a, hm_param p, hm_cycle_options *o) {
   return 0;
 }
 
+/* --out FILE (or stdout) for a command's output; NULL with *rc = 1 after saying why. */
+static FILE *open_out(const cli_args *a, int *rc) {
+  const char *path = cli_value(a, "out");
+  FILE *f = path ? fopen(path, "w") : stdout;
+  if (!f) {
+    perror(path);
+    *rc = 1;
+  }
+  return f;
+}
+
+/* Close what open_out opened: 1 (said) if the file could not be written. */
+static int close_out(const cli_args *a, FILE *f) {
+  const char *path = cli_value(a, "out");
+  if (path && fclose(f) != 0) {
+    perror(path);
+    return 1;
+  }
+  return 0;
+}
+
 /* ---- cycles of a bogie (system_cycles.h) ---- */
 
 static double system_max_modulus(const hm_system_cycle_point *c) {
@@ -408,18 +429,10 @@ static int cycles_system(const cli_args *a, hm_model_kind kind) {
   } else if (st != HM_OK) {
     rc = cli_fail_status("cycles", st);
   }
-  const char *path = cli_value(a, "out");
-  FILE *f = rc == 0 && path ? fopen(path, "w") : stdout;
-  if (rc == 0 && !f) {
-    perror(path);
-    rc = 1;
-  }
-  if (rc == 0) {
+  FILE *f = rc == 0 ? open_out(a, &rc) : NULL;
+  if (f) {
     write_system_family(f, sys, &cm.wheelset, pts, np, ev, ne, &cs, cli_has(a, "csv"));
-    if (path && fclose(f) != 0) {
-      perror(path);
-      rc = 1;
-    }
+    rc = close_out(a, f);
   }
   free(pts);
   return rc;
@@ -453,21 +466,13 @@ int cmd_cycles(const cli_args *a) {
     of.cont.max_steps *= 4;
     rc = run_family(&veh, speed, &hopf, &of, &fine);
   }
-  const char *path = cli_value(a, "out");
-  FILE *f = rc == 0 && path ? fopen(path, "w") : stdout;
-  if (rc == 0 && !f) {
-    perror(path);
-    rc = 1;
-  }
-  if (rc == 0) {
+  FILE *f = rc == 0 ? open_out(a, &rc) : NULL;
+  if (f) {
     if (cli_has(a, "csv"))
       write_branch_csv(f, &fam, hm_param_name(p));
     else
       write_family_json(f, &hopf, &fam, cli_has(a, "refine") ? &fine : NULL, p);
-    if (path && fclose(f) != 0) {
-      perror(path);
-      rc = 1;
-    }
+    rc = close_out(a, f);
   }
   free(fam.points);
   free(fine.points);

@@ -413,10 +413,12 @@ static hm_status lookup(hm_alarm a, int k, double conicity, double speed_kmh, hm
   hm_status st = hm_table_lookup_widened(a->table, conicity, speed_kmh, &r);
   if (st == HM_EDOMAIN && isfinite(conicity) && isfinite(speed_kmh)) st = hm_table_lookup(a->table, conicity, speed_kmh, &r);
   if (st != HM_OK) return st;
-  if (r.conicity != conicity && !r.widened) r.hopf_speed_kmh = hopf_kmh(&a->veh, a->model, conicity);
-  if (a->model) { /* a model's Hopf curve is exact to HM_MODE_MODEL_CURVE_ERR_KMH where the table interpolates */
+  const int clamped = r.conicity != conicity && !r.widened;
+  if (clamped || a->model) {
     const double v = hopf_kmh(&a->veh, a->model, conicity);
-    if (v < HM_LINEAR_NO_HOPF_KMH) r.hopf_speed_kmh = v, r.error_speed_kmh = HM_MODE_MODEL_CURVE_ERR_KMH;
+    if (clamped) r.hopf_speed_kmh = v;
+    /* a model's Hopf curve is exact to HM_MODE_MODEL_CURVE_ERR_KMH where the table interpolates */
+    if (a->model && v < HM_LINEAR_NO_HOPF_KMH) r.hopf_speed_kmh = v, r.error_speed_kmh = HM_MODE_MODEL_CURVE_ERR_KMH;
   }
   a->cache[k].valid = 1;
   a->cache[k].conicity = conicity;
