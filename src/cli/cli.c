@@ -197,6 +197,7 @@ int cli_vehicle_model(const cli_args *a, hm_model_kind kind, cli_model *out) {
   }
   out->kind = kind;
   out->wheelset = *w;
+  out->params = car;
   if (kind == HM_MODEL_CAR) {
     st = hm_car_model_init(&out->car, &car, 0, &out->sys);
     if (st == HM_OK) st = hm_car_model_init(&out->car_held, &car, 1, &out->held);

@@ -50,6 +50,7 @@ int cli_model_kind(const cli_args *a, hm_model_kind *kind);
 typedef struct {
   hm_model_kind kind;
   hm_vehicle wheelset;   /* the wheelsets' parameters (after the overrides) */
+  hm_car params;         /* all of them (a bogie's in params.bogie; the car's default carbody for a bogie) */
   hm_bogie_model bogie, bogie_held;
   hm_car_model car, car_held;
   hm_system sys, held;

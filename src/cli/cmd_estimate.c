@@ -365,10 +365,12 @@ int cmd_estimate(const cli_args *a) {
   const char *accel_path = cli_value(a, "accel"), *speed_path = cli_value(a, "speed");
   if (cli_model_kind(a, &kind)) return 1;
   if (kind == HM_MODEL_WHEELSET ? cli_vehicle(a, &veh, NULL) : cli_vehicle_model(a, kind, &cm)) return 1;
-  hm_car_default(&params);
-  if (kind == HM_MODEL_WHEELSET) params.bogie.wheelset = veh;
-  else if (kind == HM_MODEL_BOGIE) params.bogie = cm.bogie.bogie;
-  else params = cm.car.car;
+  if (kind == HM_MODEL_WHEELSET) {
+    hm_car_default(&params);
+    params.bogie.wheelset = veh;
+  } else {
+    params = cm.params;
+  }
   veh = params.bogie.wheelset;
   if (kind != HM_MODEL_WHEELSET && (cli_has(a, "state-in") || cli_has(a, "state-out"))) {
     fprintf(stderr, "hunting estimate: --state-in and --state-out take the wheelset model (not yet a %s)\n",

@@ -52,13 +52,9 @@ int cmd_tables(const cli_args *a) {
   timespec_get(&t0, TIME_UTC);
   hm_table t = NULL;
   hm_threads threads = {(unsigned)threads_d};
-  hm_car params;
-  hm_car_default(&params);
-  if (kind == HM_MODEL_BOGIE) params.bogie = cm.bogie.bogie;
-  if (kind == HM_MODEL_CAR) params = cm.car.car;
   hm_status st = kind == HM_MODEL_WHEELSET
                      ? hm_table_build_parallel(&veh, &spec, hm_threads_parallel_for, &threads, &t)
-                     : hm_table_build_model(kind, &params, &spec, hm_threads_parallel_for, &threads, &t);
+                     : hm_table_build_model(kind, &cm.params, &spec, hm_threads_parallel_for, &threads, &t);
   if (st == HM_EINVAL) {
     fprintf(stderr, "hunting tables: need 0 < --conicity-min < --conicity-max, 0 < --v-min < --v-max <= %g, "
                     "0.001 < --amp-max <= 0.1\n", HM_TABLE_MAX_SPEED_KMH);
