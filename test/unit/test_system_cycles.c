@@ -25,6 +25,13 @@ static void default_bogie(hm_bogie_model *m, hm_system *sys) {
   HM_CHECK(hm_bogie_model_init(m, &b, 0, sys) == HM_OK, "init");
 }
 
+/* The default car (config/car_default.yaml) as a system. */
+static void default_car(hm_car_model *m, hm_system *sys) {
+  hm_car c;
+  hm_car_default(&c);
+  HM_CHECK(hm_car_model_init(m, &c, 0, sys) == HM_OK, "init");
+}
+
 static void wheelset_folds_as_published(void) {
   hm_vehicle veh;
   hm_vehicle_default(&veh);
@@ -128,14 +135,11 @@ static void bogie_cycles_where_simulations_settle(void) {
   }
 }
 
-/* The bogie's first fold at rtol 1e-9 (the default) and at 1e-11 with atol 1e-14: the same to 1e-6 km/h. */
 /* The whole vehicle (30 states): its family's stable cycles are where simulations settle too. */
 static void car_cycles_where_simulations_settle(void) {
-  hm_car car;
-  hm_car_default(&car);
   hm_car_model m;
   hm_system sys;
-  HM_CHECK(hm_car_model_init(&m, &car, 0, &sys) == HM_OK, "init");
+  default_car(&m, &sys);
   hm_system_cycle_options opt;
   hm_system_cycle_options_default(&opt);
   opt.amp_max_m = 0.0065;
@@ -153,11 +157,9 @@ static void car_cycles_where_simulations_settle(void) {
  * is its trailing bogie hunting alone, which the leading wheelset's |y| had called 0.06 mm): checked against the
  * tests' own RK4 over one period from each tested cycle's start. */
 static void car_amplitude_over_every_wheelset(void) {
-  hm_car car;
-  hm_car_default(&car);
   hm_car_model m;
   hm_system sys;
-  HM_CHECK(hm_car_model_init(&m, &car, 0, &sys) == HM_OK, "init");
+  default_car(&m, &sys);
   hm_system_cycle_options opt;
   hm_system_cycle_options_default(&opt);
   opt.v_min_kmh = 300.0, opt.v_max_kmh = 700.0, opt.amp_max_m = 0.012;
@@ -183,6 +185,7 @@ static void car_amplitude_over_every_wheelset(void) {
   HM_CHECK(np > 10 && worst < 1e-3, "every wheelset's |y| counted");
 }
 
+/* The bogie's first fold at rtol 1e-9 (the default) and at 1e-11 with atol 1e-14: the same to 1e-6 km/h. */
 static void bogie_fold_refined(void) {
   hm_bogie_model m;
   hm_system sys;
