@@ -212,6 +212,10 @@ void hm_modal_reset(hm_modal m);
  * allocation. */
 hm_status hm_modal_set_rate(hm_modal m, double sample_rate_hz);
 
+/* |H(f)|^2 of the filters before the window (the high- and low-pass above) at the current input rate, for f_hz [Hz]
+ * (NAN for a negative or non-finite one); modal is an hm_modal (void: mode_model.h's gain callback). */
+double hm_modal_filter_power_gain(const void *modal, double f_hz);
+
 /* One acceleration sample [m/s^2] at the input rate (finite: the caller validates). */
 void hm_modal_push(hm_modal m, double accel_mps2);
 /* The speed [m/s] from now on, kept with each sample (the track lines' order tracking, order_lines.h); not finite

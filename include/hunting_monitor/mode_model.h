@@ -116,6 +116,49 @@ hm_status hm_mode_model_fit_spectrum(hm_mode_model m, double speed_kmh, const hm
                                      const double *f_hz, const double *psd, size_t n, double dof, double lo,
                                      double hi, double tol, hm_spectrum_fit *out);
 
+/* ---- the monitor's reading on the model ----
+ * The monitor reads the hunting mode off the sensor's spectrum as one or two pole pairs over a smooth background
+ * (modal.h), and on a bogie that reading is no eigenvalue: its two wheelsets meet the same track 2b / v apart and an
+ * axle box sums their responses, so its peak is sharper than the least-damped root (the default bogie, conicity
+ * 0.1358, 460 km/h: the least-damped root -4.58 1/s at 13.76 Hz; one pair reads -5.93 at 14.58 Hz, two pairs -2.18 at
+ * 14.05 beside -6.48 at 16.41). The model's reading is that same fit (whittle.h) on the model's spectrum at the sensor
+ * (above, times the measured signal's filters where given, without sensor noise: a floor of HM_MODE_MODEL_READING_FLOOR
+ * of its mean) over the model's band in bins of
+ * HM_MODE_MODEL_READING_DF_HZ, its poles moved left by the leakage of a HM_MODE_MODEL_READING_WINDOW_S window and the fit
+ * told that window (whittle.h's leakage, so that the reading is the pole pair's own; a peak sharper than the bins
+ * would leave the fit rough), started from three widths at the peak and from every root in the band; the pair the monitor takes for the mode (the less damped of
+ * two). Inverting the measured reading against it (hm_mode_model_invert_reading) compares like with like: on the
+ * wheelset it is the least-damped root to about 0.07 1/s (test_mode_model). Costs one spectrum (a complex solve of
+ * the model's dimension per bin) and one fit per conicity tried. */
+#define HM_MODE_MODEL_READING_DF_HZ 0.025
+#define HM_MODE_MODEL_READING_WINDOW_S 10.0 /* the leakage both sides are given (a peak a few bins wide) */
+#define HM_MODE_MODEL_READING_MAX_BINS 1024
+#define HM_MODE_MODEL_READING_FLOOR 1e-6
+#define HM_MODE_MODEL_READING_TOL 1e-11 /* the fit's relative change of the objective that ends it */
+#define HM_MODE_MODEL_READING_ITER 200
+#define HM_MODE_MODEL_READING_SCAN 16   /* conicities 0.02-0.8 (geometric) the reading's inversion starts from */
+
+/* The sensor whose reading the model gives ("axlebox", "frame", "carbody" as hm_mode_model_sensor); NULL: none (the
+ * inversion by roots). HM_EINVAL for a place the model has not, the sensor unchanged. */
+hm_status hm_mode_model_set_sensor(hm_mode_model m, const char *where);
+/* The power gain |H(f)|^2 of what filters the measured signal before its reading (the monitor's: modal.h's
+ * hm_modal_filter_power_gain with its hm_modal), applied to the model's spectrum; NULL: none. ctx is borrowed. */
+typedef double (*hm_mode_model_gain_fn)(const void *ctx, double f_hz);
+void hm_mode_model_set_reading_gain(hm_mode_model m, hm_mode_model_gain_fn gain, const void *ctx);
+int hm_mode_model_has_sensor(const hm_mode_model m);
+
+/* The model's reading with `poles` pairs (1 or 2) at conicity and speed: the mode's decay rate (-|sigma|, or +|sigma|
+ * where the model is unstable there: no stationary spectrum to read, and the measured one is not its mirror image)
+ * and frequency. HM_EDOMAIN without a sensor; HM_ENOCRIT if the fit finds no mode inside the band. */
+hm_status hm_mode_model_reading(hm_mode_model m, double conicity, double speed_kmh, unsigned poles, double *sigma_1_s,
+                                double *f_hz);
+
+/* hm_mode_model_invert against the model's reading of `poles` pairs (the measured window's choice) instead of its
+ * roots; with no sensor set, hm_mode_model_invert. The step tolerance is at least 1e-7 (a reading's precision). */
+hm_status hm_mode_model_invert_reading(hm_mode_model m, unsigned poles, double speed_kmh, double sigma_m,
+                                       double e_sigma, double f_m, double e_f, double tol, unsigned max_iter,
+                                       hm_conicity_inversion *out);
+
 #ifdef __cplusplus
 }
 #endif

@@ -14,6 +14,7 @@ typedef struct {
   double sigma, sigma_stat;     /* decay rate and its statistical error [1/s] */
   double lambda, lambda_se;     /* the window's conicity and its total error */
   double lambda_stat, lambda_sys; /* the statistical and systematic parts of that error */
+  unsigned poles;               /* the reading's pole pairs (modal.h; 0: not known, a restored window) */
 } window;
 
 struct hm_margin_s {
@@ -167,11 +168,12 @@ void hm_margin_set_model(hm_margin m, hm_mode_model model) {
   if (m) m->model = model;
 }
 
-/* The vehicle's model: the conicity from a mode (inversion.h's closed form for the wheelset, mode_model.h's for a
- * bogie or car) and its hunting root (the least-damped one) at a conicity and speed. */
-static hm_status invert(const hm_margin m, double speed_kmh, double sigma, double e_sigma, double f_hz, double e_f,
-                        hm_conicity_inversion *inv) {
-  return m->model ? hm_mode_model_invert(m->model, speed_kmh, sigma, e_sigma, f_hz, e_f, 1e-9, 60, inv)
+/* The vehicle's model: the conicity from a mode (inversion.h's closed form for the wheelset; for a bogie or car
+ * mode_model.h's, against the model's own reading of as many pole pairs at the sensor where one is set, else its
+ * roots) and its hunting root (the least-damped one) at a conicity and speed. */
+static hm_status invert(const hm_margin m, unsigned poles, double speed_kmh, double sigma, double e_sigma, double f_hz,
+                        double e_f, hm_conicity_inversion *inv) {
+  return m->model ? hm_mode_model_invert_reading(m->model, poles, speed_kmh, sigma, e_sigma, f_hz, e_f, 1e-9, 60, inv)
                   : hm_conicity_from_mode(&m->coef, speed_kmh, sigma, e_sigma, f_hz, e_f, 1e-9, 60, inv);
 }
 
@@ -179,6 +181,22 @@ static hm_status hunting_root(const hm_margin m, double speed_kmh, double conici
   return m->model ? hm_mode_model_least_damped(m->model, conicity, speed_kmh, sigma, omega)
                   : hm_hunting_root(&m->coef, speed_kmh, conicity, sigma, omega);
 }
+
+/* The model's root that a measured mode (decay rate, frequency) follows: a bogie has several in the band, and the
+ * least-damped one may be its frame's at 8 Hz where the axle box shows the wheelsets' at 14 (the wheelset: its one
+ * hunting root). */
+static hm_status root_near(const hm_margin m, double speed_kmh, double conicity, double sigma_ref, double f_ref_hz,
+                           double *sigma, double *omega) {
+  if (!m->model) return hm_hunting_root(&m->coef, speed_kmh, conicity, sigma, omega);
+  double f;
+  hm_status st = hm_mode_model_root(m->model, conicity, speed_kmh, sigma_ref, 1.0, f_ref_hz, 0.5, sigma, &f);
+  if (st == HM_OK) *omega = 2.0 * HM_PI * f;
+  return st;
+}
+
+/* With a model read at its sensor (mode_model.h) one pair's reading and two pairs' are different quantities (on a
+ * bogie's axle box -6.4 and -2.7 1/s in one window): the model-free line takes the windows of one kind only. */
+static int reads_by_model(const hm_margin m) { return m->model && hm_mode_model_has_sensor(m->model); }
 
 /* A reading's checks and inversion into *w (a window of window_s seconds); the verdict says whether it can be used. */
 static hm_window_verdict prepare_reading(const hm_margin m, double t_end, double speed_kmh, double spread_kmh,
@@ -199,16 +217,20 @@ static hm_window_verdict prepare_reading(const hm_margin m, double t_end, double
   double e_sigma = hypot(mode->decay_rate_se_1_s, sys_sigma);
   const double e_f = hypot(mode->frequency_se_hz, sys_f);
   hm_conicity_inversion inv;
-  if (invert(m, speed_kmh, sigma, e_sigma, mode->frequency_hz, e_f, &inv) != HM_OK) return HM_WINDOW_NO_INVERSION;
+  if (invert(m, mode->poles, speed_kmh, sigma, e_sigma, mode->frequency_hz, e_f, &inv) != HM_OK)
+    return HM_WINDOW_NO_INVERSION;
   /* the speed's range over the window: the fit averages the decay rates along it; the model's change over half the
    * range, at the conicity found, is a systematic error (on a ramp at 0.5 km/h/s, 12 km/h in 24 s, 0.4 1/s near the
    * Hopf speed of conicity 0.16), and the inversion is repeated with it */
   double s_lo, s_hi, w_unused;
-  if (spread_kmh > 0.0 && hunting_root(m, speed_kmh - 0.5 * spread_kmh, inv.conicity, &s_lo, &w_unused) == HM_OK &&
-      hunting_root(m, speed_kmh + 0.5 * spread_kmh, inv.conicity, &s_hi, &w_unused) == HM_OK) {
+  const double f_m = mode->frequency_hz;
+  if (spread_kmh > 0.0 &&
+      root_near(m, speed_kmh - 0.5 * spread_kmh, inv.conicity, sigma, f_m, &s_lo, &w_unused) == HM_OK &&
+      root_near(m, speed_kmh + 0.5 * spread_kmh, inv.conicity, sigma, f_m, &s_hi, &w_unused) == HM_OK) {
     sys_sigma = hypot(sys_sigma, 0.5 * fabs(s_hi - s_lo));
     e_sigma = hypot(mode->decay_rate_se_1_s, sys_sigma);
-    if (invert(m, speed_kmh, sigma, e_sigma, mode->frequency_hz, e_f, &inv) != HM_OK) return HM_WINDOW_NO_INVERSION;
+    if (invert(m, mode->poles, speed_kmh, sigma, e_sigma, mode->frequency_hz, e_f, &inv) != HM_OK)
+    return HM_WINDOW_NO_INVERSION;
   }
   w->t_end_s = t_end;
   if (!(inv.chi2 <= c->max_misfit_chi2)) return HM_WINDOW_MISFIT;
@@ -219,6 +241,7 @@ static hm_window_verdict prepare_reading(const hm_margin m, double t_end, double
   w->t_end_s = t_end;
   w->speed_kmh = speed_kmh;
   w->window_s = window_s;
+  w->poles = mode->poles;
   w->sigma = sigma;
   w->sigma_stat = mode->decay_rate_se_1_s;
   w->lambda = inv.conicity;
@@ -292,7 +315,8 @@ static int tracks_speed(const hm_margin m, double speed_kmh, double lambda, cons
   if (!isfinite(k) || !(se > 0.0) || !(lambda > 0.0)) return 0;
   const double v1 = 0.98 * speed_kmh, v2 = 1.02 * speed_kmh;
   double s1, w1, s2, w2;
-  if (hunting_root(m, v1, lambda, &s1, &w1) != HM_OK || hunting_root(m, v2, lambda, &s2, &w2) != HM_OK ||
+  const double sg = mode->decay_rate_1_s, f = mode->frequency_hz;
+  if (root_near(m, v1, lambda, sg, f, &s1, &w1) != HM_OK || root_near(m, v2, lambda, sg, f, &s2, &w2) != HM_OK ||
       !(w1 > 0.0 && w2 > 0.0))
     return 0;
   const double k_model = log(w2 / w1) / log(v2 / v1);
@@ -504,9 +528,21 @@ static double model_sigma(const hm_margin m, double x) {
 
 /* (b): weighted least squares of sigma on x = 1000 / v; the zero of the line with Fieller's interval, widened by the
  * line's curvature error. */
-static void model_free(const hm_margin m, const window *const *ws, size_t n, hm_margin_estimate *r) {
+static void model_free(const hm_margin m, const window *const *all, size_t n_all, hm_margin_estimate *r) {
   const hm_margin_config *c = &m->cfg;
-  if (n < 2 || r->speed_max_kmh - r->speed_min_kmh < c->min_speed_span_kmh) return;
+  const window *ws[HM_MARGIN_MAX_WINDOWS + 1];
+  size_t n = 0;
+  const int by_kind = reads_by_model(m);
+  size_t kinds[3] = {0, 0, 0};
+  for (size_t k = 0; k < n_all; ++k) kinds[all[k]->poles <= 2 ? all[k]->poles : 0]++;
+  const unsigned kind = kinds[2] > kinds[1] ? 2 : 1; /* the windows' more frequent reading (restored ones: either) */
+  double v_lo = INFINITY, v_hi = -INFINITY;
+  for (size_t k = 0; k < n_all; ++k)
+    if (!by_kind || all[k]->poles == 0 || all[k]->poles == kind) {
+      ws[n++] = all[k];
+      v_lo = fmin(v_lo, all[k]->speed_kmh), v_hi = fmax(v_hi, all[k]->speed_kmh);
+    }
+  if (n < 2 || v_hi - v_lo < c->min_speed_span_kmh) return;
   double s0 = 0.0, s1 = 0.0, s2 = 0.0, t0 = 0.0, t1 = 0.0;
   for (size_t k = 0; k < n; ++k) {
     const double wk = 1.0 / (ws[k]->sigma_stat * ws[k]->sigma_stat), x = 1000.0 / ws[k]->speed_kmh;
@@ -537,15 +573,17 @@ static void model_free(const hm_margin m, const window *const *ws, size_t n, hm_
   double x1 = (-b - sqrt(disc)) / (2.0 * a), x2 = (-b + sqrt(disc)) / (2.0 * a);
   if (!(xh > 0.0) || !isfinite(x1) || !isfinite(x2)) return;
   /* the line's own error: the model's sigma(x) against its chord through the windows' speeds, at the zero */
-  const double xa = 1000.0 / r->speed_max_kmh, xb = 1000.0 / r->speed_min_kmh;
-  const double sa = model_sigma(m, xa), sb = model_sigma(m, xb), sh = model_sigma(m, xh);
+  /* (not for a model read at its sensor: its least-damped root need not be the mode read, nor its curve the reading's) */
+  const double xa = 1000.0 / v_hi, xb = 1000.0 / v_lo;
+  const double sa = by_kind ? NAN : model_sigma(m, xa), sb = by_kind ? NAN : model_sigma(m, xb);
+  const double sh = by_kind ? NAN : model_sigma(m, xh);
   if (isfinite(sa) && isfinite(sb) && isfinite(sh) && xb > xa) {
     const double gap = sh - (sa + (sb - sa) * (xh - xa) / (xb - xa)), dx = fabs(gap / beta);
     x1 -= dx;
     x2 += dx;
   }
   const double vh = 1000.0 / xh;
-  if (vh > r->speed_max_kmh + c->max_extrapolation_kmh) return;
+  if (vh > v_hi + c->max_extrapolation_kmh) return;
   r->hopf_free_valid = 1;
   r->hopf_free_kmh = vh;
   r->hopf_free_low_kmh = 1000.0 / x2;
@@ -684,7 +722,7 @@ hm_status hm_margin_restore(hm_margin m, double now, const hm_margin_snapshot *s
   for (unsigned k = 0; k < s->n_windows; ++k) {
     const hm_margin_window *o = &s->windows[k];
     const window w = {now - o->age_s, o->speed_kmh, o->window_s, o->sigma_1_s, o->sigma_stat_1_s,
-                      o->conicity, o->conicity_se, o->conicity_stat, o->conicity_sys};
+                      o->conicity, o->conicity_se, o->conicity_stat, o->conicity_sys, 0};
     store(m, &w);
   }
   for (unsigned k = 0; k < s->n_misfits; ++k) misfit_push(m, now - s->misfit_age_s[k]);

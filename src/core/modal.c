@@ -125,6 +125,14 @@ static int rate_plan(const hm_modal_config *c, double fs, unsigned *r, double *f
   return 1;
 }
 
+double hm_modal_filter_power_gain(const void *modal, double f_hz) {
+  const hm_modal m = (const hm_modal)modal;
+  if (!m || !(f_hz >= 0.0) || !isfinite(f_hz)) return NAN;
+  const double th = 2.0 * HM_PI * f_hz / m->fs;
+  const double g = hm_biquad_gain(&m->hp, th) * hm_biquad_gain(&m->lp[0], th) * hm_biquad_gain(&m->lp[1], th);
+  return g * g;
+}
+
 static void apply_rate(hm_modal m, double fs, unsigned r, double fd) {
   m->fs = fs;
   m->r = r;

@@ -8,8 +8,9 @@
 #include "hunting_monitor/excitation.h"
 #include "hunting_monitor/linear.h"
 #include "lapack.h"
+#include "whittle.h"
 
-enum { NMAX = HM_SYSTEM_MAX_DIM };
+enum { NMAX = HM_SYSTEM_MAX_DIM, NPM = HM_WHITTLE_MAX_NP, NREAD = HM_MODE_MODEL_READING_MAX_BINS };
 
 struct hm_mode_model_s {
   hm_model_kind kind;
@@ -23,6 +24,11 @@ struct hm_mode_model_s {
   double band_lo_hz, band_hi_hz; /* the least-damped root is sought in this band */
   double grid_hopf_kmh[HM_MODE_MODEL_GRID]; /* the Hopf curve: NAN not computed yet, +inf none, 0 unstable at all */
   double grid_f_hz[HM_MODE_MODEL_GRID];     /* its critical mode's frequency */
+  int have_sensor;                          /* the reading's sensor (hm_mode_model_set_sensor) */
+  hm_sensor_point sensor;
+  hm_mode_model_gain_fn gain;               /* the measured signal's filters (NULL: none) and their context */
+  const void *gain_ctx;
+  double rd_f[NREAD], rd_w[NREAD], rd_u[NREAD], rd_p[NREAD]; /* the reading's bins and the model's spectrum */
 };
 
 static hm_status set_conicity(hm_mode_model m, double conicity) {
@@ -233,6 +239,19 @@ hm_status hm_mode_model_hopf(hm_mode_model m, double conicity, double *speed_kmh
   return HM_OK;
 }
 
+/* ---- the inversion: the conicity whose mode (a root, or the model's reading) is nearest the measured one ---- */
+
+/* The model's reading at a conicity (below): nearest the reference mode ref when given, warm-started from warm1/warm2
+ * (a one- and a two-pair fit) when given; the fits made in th1_out, th2_out. */
+typedef struct {
+  double sigma, w, e_sigma, e_w;
+} ref_mode;
+
+static hm_status reading_fit(hm_mode_model m, double conicity, double v_kmh, unsigned poles, const ref_mode *ref,
+                             const double *warm1, const double *warm2, double *th1_out, double *th2_out, double *sigma,
+                             double *w);
+static double ref_distance(const ref_mode *ref, double sigma, double w);
+
 /* The misfit's residuals and their sensitivities at lambda, following the root from (*sr, *wr). */
 typedef struct {
   double s, w, ds, dw; /* the root and d root / d lambda */
@@ -250,6 +269,23 @@ static hm_status root_with_slope(hm_mode_model m, double lambda, double v_kmh, d
   *p = (root_point){s0, w0, (sp - sm) / span, (wp - wm) / span};
   *sr = s0, *wr = w0;
   return HM_OK;
+}
+
+/* The inversion's result at its last point p (the misfit's sensitivities give the error, inversion.h's). */
+static void inversion_result(const root_point *p, double lambda, double sigma_m, double e_sigma, double w_m, double e_w,
+                             unsigned iterations, hm_conicity_inversion *out) {
+  const double j1 = p->ds / e_sigma, j2 = p->dw / e_w, r1 = (p->s - sigma_m) / e_sigma, r2 = (p->w - w_m) / e_w;
+  hm_conicity_inversion r;
+  memset(&r, 0, sizeof r);
+  r.conicity = lambda;
+  r.conicity_se = 1.0 / sqrt(j1 * j1 + j2 * j2);
+  r.chi2 = r1 * r1 + r2 * r2;
+  r.model_decay_rate_1_s = p->s;
+  r.model_frequency_hz = p->w / (2.0 * HM_PI);
+  r.dsigma_dconicity = p->ds;
+  r.dfrequency_dconicity = p->dw / (2.0 * HM_PI);
+  r.iterations = iterations;
+  *out = r;
 }
 
 hm_status hm_mode_model_invert(hm_mode_model m, double speed_kmh, double sigma_m, double e_sigma, double f_m,
@@ -282,18 +318,68 @@ hm_status hm_mode_model_invert(hm_mode_model m, double speed_kmh, double sigma_m
     if (fabs(step) > tol) continue;
     if (!(lambda > 0.0 && lambda < 10.0)) return HM_ENOCONV;
     if (root_with_slope(m, lambda, speed_kmh, e_sigma, e_w, &sr, &wr, &p) != HM_OK) return HM_ENOCONV;
-    const double j1 = p.ds / e_sigma, j2 = p.dw / e_w, r1 = (p.s - sigma_m) / e_sigma, r2 = (p.w - w_m) / e_w;
-    hm_conicity_inversion r;
-    memset(&r, 0, sizeof r);
-    r.conicity = lambda;
-    r.conicity_se = 1.0 / sqrt(j1 * j1 + j2 * j2);
-    r.chi2 = r1 * r1 + r2 * r2;
-    r.model_decay_rate_1_s = p.s;
-    r.model_frequency_hz = p.w / (2.0 * HM_PI);
-    r.dsigma_dconicity = p.ds;
-    r.dfrequency_dconicity = p.dw / (2.0 * HM_PI);
-    r.iterations = it;
-    *out = r;
+    inversion_result(&p, lambda, sigma_m, e_sigma, w_m, e_w, it, out);
+    return HM_OK;
+  }
+  return HM_ENOCONV;
+}
+
+/* The reading and its slope at lambda (a forward difference of 1e-3 lambda, the second fit warm from the first),
+ * the fits carried in th1/th2 (*have: warm). */
+static hm_status reading_with_slope(hm_mode_model m, unsigned poles, double lambda, double v_kmh, const ref_mode *ref,
+                                    double *th1, double *th2, int *have, root_point *p) {
+  const double h = 1e-3 * lambda;
+  double s0, w0, s1, w1, t1[NPM], t2[NPM], u1[NPM], u2[NPM];
+  hm_status st = reading_fit(m, lambda, v_kmh, poles, ref, *have ? th1 : NULL, *have && poles == 2 ? th2 : NULL, t1,
+                             t2, &s0, &w0);
+  if (st != HM_OK && *have) st = reading_fit(m, lambda, v_kmh, poles, ref, NULL, NULL, t1, t2, &s0, &w0);
+  if (st != HM_OK) return st;
+  if ((st = reading_fit(m, lambda + h, v_kmh, poles, NULL, t1, t2, u1, u2, &s1, &w1)) != HM_OK) return st;
+  memcpy(th1, t1, sizeof t1);
+  memcpy(th2, t2, sizeof t2);
+  *have = 1;
+  *p = (root_point){s0, w0, (s1 - s0) / h, (w1 - w0) / h};
+  return HM_OK;
+}
+
+hm_status hm_mode_model_invert_reading(hm_mode_model m, unsigned poles, double speed_kmh, double sigma_m,
+                                       double e_sigma, double f_m, double e_f, double tol, unsigned max_iter,
+                                       hm_conicity_inversion *out) {
+  if (!m || !out) return HM_EINVAL;
+  if (!m->have_sensor) return hm_mode_model_invert(m, speed_kmh, sigma_m, e_sigma, f_m, e_f, tol, max_iter, out);
+  if (poles != 1 && poles != 2) return HM_EDOMAIN;
+  if (!inputs_ok(speed_kmh, e_sigma, e_f) || !(sigma_m < 0.0) || !isfinite(sigma_m) || !(f_m > 0.0 && f_m < 1e3) ||
+      !(tol > 0.0) || max_iter < 1)
+    return HM_EDOMAIN;
+  /* the start: the scanned conicity whose reading (the peak the measured mode lies on) is nearest it, then
+   * Gauss-Newton on the reading */
+  const double w_m = 2.0 * HM_PI * f_m, e_w = 2.0 * HM_PI * e_f;
+  const ref_mode ref = {sigma_m, w_m, e_sigma, e_w};
+  double lambda = NAN, best = INFINITY, th1[NPM], th2[NPM];
+  for (int k = 0; k < HM_MODE_MODEL_READING_SCAN; ++k) {
+    const double l = 0.02 * pow(40.0, (double)k / (HM_MODE_MODEL_READING_SCAN - 1)); /* 0.02..0.8, geometric */
+    double s, w;
+    if (reading_fit(m, l, speed_kmh, poles, &ref, NULL, NULL, th1, th2, &s, &w) != HM_OK) continue;
+    const double d = ref_distance(&ref, s, w);
+    if (d < best) best = d, lambda = l;
+  }
+  if (!isfinite(lambda)) return HM_ENOCONV;
+  int have = 0;
+  tol = fmax(tol, 1e-6);
+  for (unsigned it = 1; it <= max_iter; ++it) {
+    root_point p;
+    if (reading_with_slope(m, poles, lambda, speed_kmh, &ref, th1, th2, &have, &p) != HM_OK) return HM_ENOCONV;
+    const double jr = p.ds / e_sigma, ji = p.dw / e_w, rr = (p.s - sigma_m) / e_sigma, ri = (p.w - w_m) / e_w;
+    const double jj = jr * jr + ji * ji;
+    if (!(jj > 0.0) || !isfinite(jj)) return HM_ENOCONV;
+    double step = -(jr * rr + ji * ri) / jj;
+    step = fmax(fmin(step, 0.5 * lambda + 0.01), -0.5 * lambda);
+    if (fabs(step) > tol * fmax(lambda, 1.0)) {
+      lambda += step;
+      continue;
+    }
+    if (!(lambda > 0.0 && lambda < 10.0)) return HM_ENOCONV;
+    inversion_result(&p, lambda, sigma_m, e_sigma, w_m, e_w, it, out);
     return HM_OK;
   }
   return HM_ENOCONV;
@@ -313,8 +399,18 @@ hm_status hm_mode_model_sensor(hm_mode_model m, const char *where, hm_sensor_poi
   }
 }
 
+/* The shape at s = i w + shift: shift > 0 moves every pole left by it (each Lorentzian widened by shift, as a window's
+ * leakage does, whittle.h). */
+static hm_status sensor_spectrum(hm_mode_model m, double conicity, double speed_kmh, const hm_sensor_point *point,
+                                 const double *f_hz, size_t n, double shift, double *shape);
+
 hm_status hm_mode_model_sensor_spectrum(hm_mode_model m, double conicity, double speed_kmh,
                                         const hm_sensor_point *point, const double *f_hz, size_t n, double *shape) {
+  return sensor_spectrum(m, conicity, speed_kmh, point, f_hz, n, 0.0, shape);
+}
+
+static hm_status sensor_spectrum(hm_mode_model m, double conicity, double speed_kmh, const hm_sensor_point *point,
+                                 const double *f_hz, size_t n, double shift, double *shape) {
   if (!m || !point || !f_hz || !shape || n == 0 || !(speed_kmh > 0.0) || !isfinite(speed_kmh) ||
       !isfinite(conicity) || conicity < 0.0)
     return HM_EDOMAIN;
@@ -341,11 +437,11 @@ hm_status hm_mode_model_sensor_spectrum(hm_mode_model m, double conicity, double
     double _Complex a[NMAX * NMAX], u[NMAX];
     for (size_t r = 0; r < d; ++r) {
       u[r] = 0.0;
-      for (size_t c = 0; c < d; ++c) a[r + d * c] = (r == c ? I * w : 0.0) - jac[d * r + c]; /* column-major */
+      for (size_t c = 0; c < d; ++c) a[r + d * c] = (r == c ? I * w + shift : 0.0) - jac[d * r + c]; /* column-major */
     }
     double _Complex ua[HM_SYSTEM_MAX_WHEELSETS];
     for (size_t i = 0; i < nw; ++i) {
-      ua[i] = cexp(-I * w * (sys->wheelset_x_m[0] - sys->wheelset_x_m[i]) / v);
+      ua[i] = cexp(-(I * w + shift) * (sys->wheelset_x_m[0] - sys->wheelset_x_m[i]) / v);
       for (size_t r = 0; r < d; ++r) u[r] += B[i][r] * ua[i];
     }
     double _Complex x[NMAX];
@@ -355,7 +451,7 @@ hm_status hm_mode_model_sensor_spectrum(hm_mode_model m, double conicity, double
     zgesv_(&nn, &one, a, &nn, ipiv, x, &nn, &info);
     if (info != 0) return HM_ELAPACK;
     double _Complex acc = 0.0; /* the point's sum of accelerations: rows of i w X (= A X + B u) */
-    for (size_t j = 0; j < point->n_terms; ++j) acc += point->weight[j] * I * w * x[point->state[j]];
+    for (size_t j = 0; j < point->n_terms; ++j) acc += point->weight[j] * (I * w + shift) * x[point->state[j]];
     const double S = hm_track_alignment_psd(w / v) / v;
     shape[k] = creal(acc * conj(acc)) * S;
     if (!isfinite(shape[k])) return HM_ENONFINITE;
@@ -446,5 +542,172 @@ hm_status hm_mode_model_fit_spectrum(hm_mode_model m, double speed_kmh, const hm
   out->amplitude = amp;
   out->noise = fl;
   out->neg2_log_lik = dof * l0;
+  return HM_OK;
+}
+
+/* ---- the monitor's reading on the model ---- */
+
+hm_status hm_mode_model_set_sensor(hm_mode_model m, const char *where) {
+  if (!m) return HM_EINVAL;
+  if (!where) {
+    m->have_sensor = 0;
+    return HM_OK;
+  }
+  hm_sensor_point p;
+  hm_status st = hm_mode_model_sensor(m, where, &p);
+  if (st != HM_OK) return st;
+  m->sensor = p;
+  m->have_sensor = 1;
+  return HM_OK;
+}
+
+int hm_mode_model_has_sensor(const hm_mode_model m) { return m && m->have_sensor; }
+
+void hm_mode_model_set_reading_gain(hm_mode_model m, hm_mode_model_gain_fn gain, const void *ctx) {
+  if (!m) return;
+  m->gain = gain;
+  m->gain_ctx = ctx;
+}
+
+/* A fit's pair (0 or 1) as a mode: its decay rate -|sigma| and angular frequency |w0|. */
+static void pair_of(const double *th, int second, double *sigma, double *w) {
+  *sigma = -fabs(th[second ? HM_W_SIGMA2 : HM_W_SIGMA]);
+  *w = fabs(th[second ? HM_W_W02 : HM_W_W0]);
+}
+
+/* A candidate's distance from the reference (0 without one: then the best objective chooses). */
+static double ref_distance(const ref_mode *ref, double sigma, double w) {
+  if (!ref) return 0.0;
+  const double a = (sigma - ref->sigma) / ref->e_sigma, b = (w - ref->w) / ref->e_w;
+  return a * a + b * b;
+}
+
+/* The candidate fits of `poles` pairs from starts[0..n): the one nearest ref (in_band), else of least objective. */
+static int choose_fit(const hm_whittle_data *d, unsigned poles, double (*starts)[NPM], int n, const ref_mode *ref,
+                      double w_lo, double w_hi, double *th) {
+  double best = INFINITY, fi[NPM][NPM], obj;
+  unsigned it;
+  int found = 0;
+  for (int k = 0; k < n; ++k) {
+    if (!hm_whittle_score(d, poles, starts[k], HM_MODE_MODEL_READING_TOL, HM_MODE_MODEL_READING_ITER, &obj, fi, &it))
+      continue;
+    const int second = poles == 2 && fabs(starts[k][HM_W_SIGMA2]) < fabs(starts[k][HM_W_SIGMA]);
+    double sg, w;
+    pair_of(starts[k], second, &sg, &w);
+    if (!(w > w_lo && w < w_hi)) continue;
+    const double score = ref ? ref_distance(ref, sg, w) : obj;
+    if (score < best) {
+      best = score;
+      memcpy(th, starts[k], sizeof(double) * NPM);
+      found = 1;
+    }
+  }
+  return found;
+}
+
+static hm_status reading_fit(hm_mode_model m, double conicity, double v_kmh, unsigned poles, const ref_mode *ref,
+                             const double *warm1, const double *warm2, double *th1_out, double *th2_out, double *sigma,
+                             double *w) {
+  if (!m->have_sensor) return HM_EINVAL;
+  const double df = HM_MODE_MODEL_READING_DF_HZ;
+  size_t n = (size_t)floor((m->band_hi_hz - m->band_lo_hz) / df) + 1;
+  if (n > NREAD) n = NREAD;
+  if (n < 16) return HM_EDOMAIN;
+  const double w_ref = 2.0 * HM_PI * sqrt(fmax(m->band_lo_hz, df) * m->band_hi_hz);
+  for (size_t k = 0; k < n; ++k) {
+    m->rd_f[k] = fmax(m->band_lo_hz, 0.5 * df) + df * (double)k;
+    m->rd_w[k] = 2.0 * HM_PI * m->rd_f[k];
+    m->rd_u[k] = log(m->rd_w[k] / w_ref);
+  }
+  /* the leakage of a window of HM_MODE_MODEL_READING_WINDOW_S on both sides: the spectrum's poles moved left by
+   * HM_WHITTLE_LEAKAGE / T and the fit told T (a peak far narrower than the bins is then a few bins wide) */
+  const double T = HM_MODE_MODEL_READING_WINDOW_S;
+  hm_status st = sensor_spectrum(m, conicity, v_kmh, &m->sensor, m->rd_f, n, HM_WHITTLE_LEAKAGE / T, m->rd_p);
+  if (st != HM_OK) return st;
+  double mean = 0.0;
+  for (size_t k = 0; k < n; ++k) {
+    if (m->gain) m->rd_p[k] *= m->gain(m->gain_ctx, m->rd_f[k]);
+    mean += m->rd_p[k];
+  }
+  mean /= (double)n;
+  if (!(mean > 0.0) || !isfinite(mean)) return HM_ENONFINITE;
+  for (size_t k = 0; k < n; ++k) m->rd_p[k] = m->rd_p[k] / mean + HM_MODE_MODEL_READING_FLOOR;
+  const hm_whittle_data d = {m->rd_w, m->rd_u, m->rd_p, n, T};
+  const double w_lo = 2.0 * HM_PI * m->band_lo_hz, w_hi = 2.0 * HM_PI * m->band_hi_hz;
+  enum { MAX_STARTS = 4 + NMAX / 2 };
+  double starts[MAX_STARTS][NPM], th1[NPM], th2[NPM];
+  memset(starts, 0, sizeof starts);
+  memset(th2, 0, sizeof th2);
+  int found = 0, ns = 0;
+  if (warm1) {
+    memcpy(starts[0], warm1, sizeof starts[0]);
+    found = choose_fit(&d, 1, starts, 1, NULL, w_lo, w_hi, th1);
+  }
+  if (!found) {
+    /* three widths at the spectrum's peak (a smooth peak's fit may settle off it from a narrow start), the reference,
+     * and every oscillatory root in the band */
+    hm_whittle_cold_start(&d, 2, -0.7, starts[ns++]);
+    hm_whittle_cold_start(&d, 2, -4.0, starts[ns++]);
+    hm_whittle_cold_start(&d, 2, -10.0, starts[ns++]);
+    if (ref) { /* at the reference alone: the peak it lies on */
+      memcpy(starts[0], starts[1], sizeof starts[0]);
+      starts[0][HM_W_SIGMA] = fmin(ref->sigma, -0.1);
+      starts[0][HM_W_W0] = ref->w;
+      ns = 1;
+    }
+    double re[NMAX], im[NMAX];
+    if (!ref && hm_system_eig(&m->sys, hm_mps_from_kmh(v_kmh), re, im, NULL) == HM_OK)
+      for (size_t i = 0; i < m->sys.dim && ns < MAX_STARTS; ++i) {
+        if (!(im[i] > w_lo && im[i] < w_hi)) continue;
+        memcpy(starts[ns], starts[1], sizeof starts[0]);
+        starts[ns][HM_W_SIGMA] = fmin(re[i], -0.1);
+        starts[ns++][HM_W_W0] = im[i];
+      }
+    found = choose_fit(&d, 1, starts, ns, poles == 1 ? ref : NULL, w_lo, w_hi, th1);
+  }
+  if (!found) return HM_ENOCRIT;
+  const double *th = th1;
+  if (poles == 2) {
+    ns = 0;
+    if (warm2) memcpy(starts[ns++], warm2, sizeof starts[0]);
+    if (!warm2 || !choose_fit(&d, 2, starts, 1, NULL, w_lo, w_hi, th2)) {
+      ns = 0;
+      hm_whittle_split_start(th1, T, 0.4, starts[ns++]);
+      hm_whittle_split_start(th1, T, 0.15, starts[ns++]);
+      if (!choose_fit(&d, 2, starts, ns, ref, w_lo, w_hi, th2)) return HM_ENOCRIT;
+    }
+    th = th2;
+  }
+  const int second = poles == 2 && fabs(th2[HM_W_SIGMA2]) < fabs(th2[HM_W_SIGMA]); /* the less damped (modal.c) */
+  double s, ww;
+  pair_of(th, second, &s, &ww);
+  /* a stationary spectrum tells |sigma| alone; where the model is unstable (beyond its Hopf conicity at this speed)
+   * there is none to read: the reading is given growing (+|sigma|), so that no measured (decaying) reading is
+   * explained there by the mirror image of the stable side */
+  double re[NMAX], im[NMAX];
+  if ((st = hm_system_eig(&m->sys, hm_mps_from_kmh(v_kmh), re, im, NULL)) != HM_OK) return st;
+  for (size_t i = 0; i < m->sys.dim; ++i)
+    if (re[i] >= 0.0) {
+      s = fabs(s);
+      break;
+    }
+  memcpy(th1_out, th1, sizeof th1);
+  memcpy(th2_out, th2, sizeof th2);
+  *sigma = s;
+  *w = ww;
+  return HM_OK;
+}
+
+hm_status hm_mode_model_reading(hm_mode_model m, double conicity, double speed_kmh, unsigned poles, double *sigma_1_s,
+                                double *f_hz) {
+  if (!m || !sigma_1_s || !f_hz) return HM_EINVAL;
+  if (!m->have_sensor || (poles != 1 && poles != 2) || !(speed_kmh > 0.0) || !isfinite(speed_kmh) ||
+      !isfinite(conicity) || conicity < 0.0)
+    return HM_EDOMAIN;
+  double t1[NPM], t2[NPM], s, w;
+  hm_status st = reading_fit(m, conicity, speed_kmh, poles, NULL, NULL, NULL, t1, t2, &s, &w);
+  if (st != HM_OK) return st;
+  *sigma_1_s = s;
+  *f_hz = w / (2.0 * HM_PI);
   return HM_OK;
 }

@@ -177,6 +177,10 @@ hm_status hm_monitor_create_model(const hm_monitor_config *cfg, hm_model_kind ki
   if (st == HM_OK) st = hm_alarm_create(&cfg->alarm, veh, table, &m->alarm, why, len);
   if (st == HM_OK && model) {
     st = hm_mode_model_set_band(model, cfg->modal.band_low_hz, cfg->modal.band_high_hz);
+    /* the identified mode is compared with what the same reading gives on the model at the sensor (mode_model.h) */
+    if (st == HM_OK)
+      st = hm_mode_model_set_sensor(model, cfg->estimator.measurement_point == HM_POINT_BOGIE_FRAME ? "frame" : "axlebox");
+    hm_mode_model_set_reading_gain(model, hm_modal_filter_power_gain, m->modal);
     hm_margin_set_model(m->margin, model);
     if (st == HM_OK) st = hm_alarm_set_model(m->alarm, model);
   }
