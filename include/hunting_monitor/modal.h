@@ -183,6 +183,9 @@ typedef struct {
 /* A reading is informative when decay_rate_se <= HM_MODAL_INFORMATIVE_SE_1_S + HM_MODAL_INFORMATIVE_REL |sigma|. */
 #define HM_MODAL_INFORMATIVE_SE_1_S 0.5
 #define HM_MODAL_INFORMATIVE_REL 0.5
+/* A warm start whose pair's spectral peak lies below this times the band's mean level is no mode: cold starts are
+ * tried beside it (the better likelihood kept). */
+#define HM_MODAL_WARM_MIN_PEAK 1.0
 /* Two pole pairs are chosen when 2 (L1 - L2), over the independent ordinates, exceeds this: the three more parameters'
  * chi-square beyond its 0.02% point, and about BIC's 3 ln(n) for the 600-700 bins of a band (the narrower pair may sit
  * anywhere: at 12 a chance bump on a broad mode's flank was read as a mode of -0.6 1/s in 0.5% of single-pole windows

@@ -456,11 +456,22 @@ static int fit_reading(hm_modal m, warm_start *ws, const window_geometry *g, siz
     found = best_of(&d, 1, (const double(*)[NPM])starts, 1, m->cfg.max_iter, m->cfg.tol, th1, &obj1, f1, &iters) &&
             in_band(m, th1[HM_W_W0]);
   }
-  if (!found) {
+  /* ... and a peak: a pair below the band's mean level is no mode, and warm-started it would be followed for good
+   * (a bogie frame's first windows held a 17 Hz bump of 0.07 times the mean, and the 8 Hz mode that grew beside it
+   * later was never fitted: cold starts again, the better likelihood kept) */
+  const int stuck = found && hm_whittle_peak(th1, 0, g->T, g->w_ref) < HM_MODAL_WARM_MIN_PEAK;
+  if (!found || stuck) {
     const size_t h = (size_t)fmax(1.0, round(0.1 / g->df)); /* 0.1 Hz half-width */
+    double th_c[NPM], f_c[NPM][NPM], obj_c;
     hm_whittle_cold_start(&d, h, -0.7, starts[0]);
     hm_whittle_cold_start(&d, h, -4.0, starts[1]);
-    found = best_of(&d, 1, (const double(*)[NPM])starts, 2, m->cfg.max_iter, m->cfg.tol, th1, &obj1, f1, &iters);
+    if (best_of(&d, 1, (const double(*)[NPM])starts, 2, m->cfg.max_iter, m->cfg.tol, th_c, &obj_c, f_c, &iters) &&
+        (!found || obj_c < obj1)) {
+      memcpy(th1, th_c, sizeof th_c);
+      memcpy(f1, f_c, sizeof f_c);
+      obj1 = obj_c;
+      found = 1;
+    }
   }
   ws->have1 = found;
   if (!found) {
