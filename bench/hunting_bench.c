@@ -5,6 +5,7 @@
 #include <stdlib.h>
 #include <time.h>
 
+#include "hunting_monitor/mode_model.h"
 #include "hunting_monitor/monitor.h"
 #include "hunting_monitor/conicity_fit.h"
 #include "hunting_monitor/contact.h"
@@ -335,6 +336,29 @@ static double bench_delta_r(void) {
 
 /* EN 15302 from a delta-r of 201 points (-10..10 mm every 0.1 mm, a worn profile's cubic rise): the 66 amplitudes
  * 1..7.5 mm by each method, the table's set-up included [ms], best of 5. */
+/* The monitor's reading on the default bogie at its axle box (mode_model.h): one reading (its spectrum over 6-22 Hz
+ * and the fit of one or two pairs from cold starts), and the inversion of a measured reading against it (the
+ * monitor's per window with a bogie model). */
+static void bench_model_reading(double *reading_ms, double *invert_ms) {
+  hm_bogie b;
+  hm_bogie_default(&b);
+  hm_mode_model m = NULL;
+  *reading_ms = *invert_ms = NAN;
+  if (hm_mode_model_create_bogie(&b, &m) != HM_OK) return;
+  hm_mode_model_set_band(m, 6.0, 22.0);
+  hm_mode_model_set_sensor(m, "axlebox");
+  enum { N = 20 };
+  double s2 = 0.0, f2 = 0.0, t0 = now_s();
+  for (int k = 0; k < N; ++k) hm_mode_model_reading(m, 0.13 + 1e-4 * k, 480.0, 2, &s2, &f2);
+  *reading_ms = (now_s() - t0) / N * 1e3;
+  hm_conicity_inversion inv;
+  t0 = now_s();
+  for (int k = 0; k < N / 4; ++k)
+    hm_mode_model_invert_reading(m, 2, 480.0, s2 * (1.0 + 0.01 * k), 0.3, f2, 0.05, 1e-9, 60, &inv);
+  *invert_ms = (now_s() - t0) / (N / 4) * 1e3;
+  hm_mode_model_destroy(m);
+}
+
 static void bench_eqcon(double *int_ms, double *reg_ms) {
   static double y[201], dr[201];
   for (int k = 0; k < 201; ++k) {
@@ -420,6 +444,8 @@ int main(void) {
   bench_monitor(&ns_push, &ns_monitor, &ns_ramp, &ns_update, &us_fit);
   double eq_int_ms = NAN, eq_reg_ms = NAN;
   bench_eqcon(&eq_int_ms, &eq_reg_ms);
+  double reading_ms, invert_reading_ms;
+  bench_model_reading(&reading_ms, &invert_reading_ms);
   const double dr_ms = bench_delta_r();
 
   printf("{\n");
@@ -440,6 +466,8 @@ int main(void) {
   printf("  \"bogie_family_150_700_kmh_ms\": %.4g,\n", bogie_family_s * 1e3);
   printf("  \"bogie_family_points\": %zu,\n", bogie_points);
   printf("  \"bogie_family_folds\": %zu,\n", bogie_folds);
+  printf("  \"bogie_axlebox_model_reading_ms\": %.4g,\n", reading_ms);
+  printf("  \"bogie_axlebox_reading_inversion_ms\": %.4g,\n", invert_reading_ms);
   printf("  \"lpc_curve_kx_9.0_10.7_ms\": %.4g,\n", lpc_s * 1e3);
   printf("  \"lpc_curve_points\": %zu,\n", lpc_points);
   printf("  \"lpc_curve_cusp_kx\": %.6f,\n", cusp_kx);
