@@ -207,9 +207,14 @@ void hm_margin_read(const hm_margin m, double now_s, hm_margin_estimate *out);
 /* The closed-form Hopf speed [km/h] of the vehicle at a conicity; HM_TABLE_MAX_SPEED_KMH-like large value (1e4)
  * when the linear model is stable at every speed there. */
 double hm_margin_hopf_kmh(const hm_margin m, double conicity);
-/* Read the modes with a bogie's or car's model instead of the wheelset's closed forms (issue #28): its conicity from
- * the mode, its least-damped root and its Hopf curve (mode_model.h). Borrowed: the caller keeps model alive; NULL
- * returns to the wheelset. */
+/* Read the modes with a bogie's or car's model instead of the wheelset's closed forms (issue #28; mode_model.h): a
+ * window's conicity from the model's own reading of as many pole pairs at the model's sensor where one is set
+ * (hm_mode_model_set_sensor: the peak an axle box shows on a bogie is no eigenvalue), else from its roots; the
+ * speed range's systematic error and the order tracking's d ln f / d ln V from the root nearest the reading; the
+ * Hopf curve. With a sensor set the model-free line (b) takes the windows of the more frequent pole count only (one
+ * pair's reading and two pairs' differ on a bogie: -6.4 and -2.7 1/s in one window) and no curvature term (the
+ * least-damped root need not be the mode read). Borrowed: the caller keeps model alive; NULL returns to the
+ * wheelset. */
 void hm_margin_set_model(hm_margin m, hm_mode_model model);
 
 /* What the margin has learned, as plain data whose times are ages before a "now" [s] (state.h keeps it through a

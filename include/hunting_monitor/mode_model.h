@@ -124,9 +124,12 @@ hm_status hm_mode_model_fit_spectrum(hm_mode_model m, double speed_kmh, const hm
  * 14.05 beside -6.48 at 16.41). The model's reading is that same fit (whittle.h) on the model's spectrum at the sensor
  * (above, times the measured signal's filters where given, without sensor noise: a floor of HM_MODE_MODEL_READING_FLOOR
  * of its mean) over the model's band in bins of
- * HM_MODE_MODEL_READING_DF_HZ, its poles moved left by the leakage of a HM_MODE_MODEL_READING_WINDOW_S window and the fit
+ * HM_MODE_MODEL_READING_DF_HZ (wider where the band needs more than HM_MODE_MODEL_READING_MAX_BINS), its poles moved left by the leakage of a HM_MODE_MODEL_READING_WINDOW_S window and the fit
  * told that window (whittle.h's leakage, so that the reading is the pole pair's own; a peak sharper than the bins
- * would leave the fit rough), started from three widths at the peak and from every root in the band; the pair the monitor takes for the mode (the less damped of
+ * would leave the fit rough), started from three widths at the peak and from every root in the band (the best likelihood kept), or within an
+ * inversion from the measured mode and from the peak (the one nearest the measured mode kept); a fit counts as a mode
+ * when its damping ratio is below HM_MODE_MODEL_READING_MAX_ZETA and its peak above HM_MODE_MODEL_READING_MIN_PEAK
+ * times the band's mean; the pair the monitor takes for the mode (the less damped of
  * two). Inverting the measured reading against it (hm_mode_model_invert_reading) compares like with like: on the
  * wheelset it is the least-damped root to about 0.07 1/s (test_mode_model). Costs one spectrum (a complex solve of
  * the model's dimension per bin) and one fit per conicity tried. */
@@ -134,6 +137,8 @@ hm_status hm_mode_model_fit_spectrum(hm_mode_model m, double speed_kmh, const hm
 #define HM_MODE_MODEL_READING_WINDOW_S 10.0 /* the leakage both sides are given (a peak a few bins wide) */
 #define HM_MODE_MODEL_READING_MAX_BINS 1024
 #define HM_MODE_MODEL_READING_FLOOR 1e-6
+#define HM_MODE_MODEL_READING_MAX_ZETA 0.5  /* a reading more damped than this is no mode (modal.h's validity) */
+#define HM_MODE_MODEL_READING_MIN_PEAK 1.0  /* nor one whose peak lies below the band's mean level */
 #define HM_MODE_MODEL_READING_TOL 1e-11 /* the fit's relative change of the objective that ends it */
 #define HM_MODE_MODEL_READING_ITER 200
 #define HM_MODE_MODEL_READING_SCAN 16   /* conicities 0.02-0.8 (geometric) the reading's inversion starts from */
@@ -148,13 +153,15 @@ void hm_mode_model_set_reading_gain(hm_mode_model m, hm_mode_model_gain_fn gain,
 int hm_mode_model_has_sensor(const hm_mode_model m);
 
 /* The model's reading with `poles` pairs (1 or 2) at conicity and speed: the mode's decay rate (-|sigma|, or +|sigma|
- * where the model is unstable there: no stationary spectrum to read, and the measured one is not its mirror image)
- * and frequency. HM_EDOMAIN without a sensor; HM_ENOCRIT if the fit finds no mode inside the band. */
+ * where the root it follows, the oscillatory one nearest it in frequency, is unstable: no stationary spectrum to read,
+ * and the measured one is not its mirror image) and frequency. Without a measured mode to follow the best-fitting
+ * peak is read, which may change from one peak to another with the conicity. HM_EDOMAIN without a sensor; HM_ENOCRIT if the fit finds no mode inside the band. */
 hm_status hm_mode_model_reading(hm_mode_model m, double conicity, double speed_kmh, unsigned poles, double *sigma_1_s,
                                 double *f_hz);
 
 /* hm_mode_model_invert against the model's reading of `poles` pairs (the measured window's choice) instead of its
- * roots; with no sensor set, hm_mode_model_invert. The step tolerance is at least 1e-7 (a reading's precision). */
+ * roots; with no sensor set, hm_mode_model_invert. The step tolerance is at least 1e-6 max(lambda, 1) (a reading's
+ * precision). */
 hm_status hm_mode_model_invert_reading(hm_mode_model m, unsigned poles, double speed_kmh, double sigma_m,
                                        double e_sigma, double f_m, double e_f, double tol, unsigned max_iter,
                                        hm_conicity_inversion *out);

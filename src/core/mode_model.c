@@ -346,8 +346,8 @@ hm_status hm_mode_model_invert_reading(hm_mode_model m, unsigned poles, double s
                                        double e_sigma, double f_m, double e_f, double tol, unsigned max_iter,
                                        hm_conicity_inversion *out) {
   if (!m || !out) return HM_EINVAL;
-  if (!m->have_sensor) return hm_mode_model_invert(m, speed_kmh, sigma_m, e_sigma, f_m, e_f, tol, max_iter, out);
   if (poles != 1 && poles != 2) return HM_EDOMAIN;
+  if (!m->have_sensor) return hm_mode_model_invert(m, speed_kmh, sigma_m, e_sigma, f_m, e_f, tol, max_iter, out);
   if (!inputs_ok(speed_kmh, e_sigma, e_f) || !(sigma_m < 0.0) || !isfinite(sigma_m) || !(f_m > 0.0 && f_m < 1e3) ||
       !(tol > 0.0) || max_iter < 1)
     return HM_EDOMAIN;
@@ -595,6 +595,10 @@ static int choose_fit(const hm_whittle_data *d, unsigned poles, double (*starts)
     double sg, w;
     pair_of(starts[k], second, &sg, &w);
     if (!(w > w_lo && w < w_hi)) continue;
+    /* a mode as the monitor's validity has it (modal.h): lightly damped, and a peak above the band's mean level */
+    if (!(-sg < HM_MODE_MODEL_READING_MAX_ZETA * hypot(sg, w)) ||
+        !(hm_whittle_peak(starts[k], (unsigned)second, d->window_s, w) >= HM_MODE_MODEL_READING_MIN_PEAK))
+      continue;
     const double score = ref ? ref_distance(ref, sg, w) : obj;
     if (score < best) {
       best = score;
@@ -609,7 +613,8 @@ static hm_status reading_fit(hm_mode_model m, double conicity, double v_kmh, uns
                              const double *warm1, const double *warm2, double *th1_out, double *th2_out, double *sigma,
                              double *w) {
   if (!m->have_sensor) return HM_EINVAL;
-  const double df = HM_MODE_MODEL_READING_DF_HZ;
+  /* HM_MODE_MODEL_READING_DF_HZ, or wider where the band needs more than NREAD bins */
+  const double df = fmax(HM_MODE_MODEL_READING_DF_HZ, (m->band_hi_hz - m->band_lo_hz) / (double)(NREAD - 1));
   size_t n = (size_t)floor((m->band_hi_hz - m->band_lo_hz) / df) + 1;
   if (n > NREAD) n = NREAD;
   if (n < 16) return HM_EDOMAIN;
@@ -649,11 +654,16 @@ static hm_status reading_fit(hm_mode_model m, double conicity, double v_kmh, uns
     hm_whittle_cold_start(&d, 2, -0.7, starts[ns++]);
     hm_whittle_cold_start(&d, 2, -4.0, starts[ns++]);
     hm_whittle_cold_start(&d, 2, -10.0, starts[ns++]);
-    if (ref) { /* at the reference alone: the peak it lies on */
+    if (ref) { /* at the reference (its level the spectrum's there) and at the peak: the one nearest it is kept */
       memcpy(starts[0], starts[1], sizeof starts[0]);
       starts[0][HM_W_SIGMA] = fmin(ref->sigma, -0.1);
       starts[0][HM_W_W0] = ref->w;
-      ns = 1;
+      size_t kr = 0;
+      for (size_t k = 1; k < n; ++k)
+        if (fabs(m->rd_w[k] - ref->w) < fabs(m->rd_w[kr] - ref->w)) kr = k;
+      const double at = hm_whittle_peak(starts[0], 0, T, ref->w);
+      if (at > 0.0 && isfinite(at)) starts[0][HM_W_C0] += log(m->rd_p[kr] / at);
+      ns = 2; /* and starts[1], the cold one at the peak */
     }
     double re[NMAX], im[NMAX];
     if (!ref && hm_system_eig(&m->sys, hm_mps_from_kmh(v_kmh), re, im, NULL) == HM_OK)
@@ -686,11 +696,10 @@ static hm_status reading_fit(hm_mode_model m, double conicity, double v_kmh, uns
    * explained there by the mirror image of the stable side */
   double re[NMAX], im[NMAX];
   if ((st = hm_system_eig(&m->sys, hm_mps_from_kmh(v_kmh), re, im, NULL)) != HM_OK) return st;
+  size_t kf = m->sys.dim; /* the oscillatory root the read pair follows: nearest it in frequency */
   for (size_t i = 0; i < m->sys.dim; ++i)
-    if (re[i] >= 0.0) {
-      s = fabs(s);
-      break;
-    }
+    if (im[i] > 0.0 && (kf == m->sys.dim || fabs(im[i] - ww) < fabs(im[kf] - ww))) kf = i;
+  if (kf < m->sys.dim && re[kf] >= 0.0) s = fabs(s);
   memcpy(th1_out, th1, sizeof th1);
   memcpy(th2_out, th2, sizeof th2);
   *sigma = s;
@@ -701,7 +710,7 @@ static hm_status reading_fit(hm_mode_model m, double conicity, double v_kmh, uns
 hm_status hm_mode_model_reading(hm_mode_model m, double conicity, double speed_kmh, unsigned poles, double *sigma_1_s,
                                 double *f_hz) {
   if (!m || !sigma_1_s || !f_hz) return HM_EINVAL;
-  if (!m->have_sensor || (poles != 1 && poles != 2) || !(speed_kmh > 0.0) || !isfinite(speed_kmh) ||
+  if (!m->have_sensor || (poles != 1 && poles != 2) || !(speed_kmh > 0.0) || !(speed_kmh < 1e4) ||
       !isfinite(conicity) || conicity < 0.0)
     return HM_EDOMAIN;
   double t1[NPM], t2[NPM], s, w;
