@@ -103,8 +103,9 @@ class TimeJump(unittest.TestCase):
         self.assertAlmostEqual(last.speed_kmh, 400.0)
         self.assertTrue(last.oscillation_valid and abs(last.frequency_hz - 14.0) < 0.2, last.frequency_hz)
         # ROS time - stamp: -3600 s plus the least latency (well under 50 ms here); in simulated time the node's
-        # clock may lag the stamps by a few /clock messages (2 ms each), so the least can be a little below -3600
-        self.assertTrue(-3600.02 <= last.sensor_clock_offset_s < -3600.0 + 0.05, last.sensor_clock_offset_s)
+        # clock may lag the stamps by some /clock messages (2 ms each), so the least can be a little below -3600: 12 of
+        # them (-3600.024) in a full suite run of 2026-12-03 on a loaded VM; 25 allowed
+        self.assertTrue(-3600.05 <= last.sensor_clock_offset_s < -3600.0 + 0.05, last.sensor_clock_offset_s)
         self.assertGreaterEqual(last.sensor_clock_steps, 1)
 
     def test_2_sensor_clock_behind(self):
