@@ -230,7 +230,7 @@ static hm_window_verdict prepare_reading(const hm_margin m, double t_end, double
     sys_sigma = hypot(sys_sigma, 0.5 * fabs(s_hi - s_lo));
     e_sigma = hypot(mode->decay_rate_se_1_s, sys_sigma);
     if (invert(m, mode->poles, speed_kmh, sigma, e_sigma, mode->frequency_hz, e_f, &inv) != HM_OK)
-    return HM_WINDOW_NO_INVERSION;
+      return HM_WINDOW_NO_INVERSION;
   }
   w->t_end_s = t_end;
   if (!(inv.chi2 <= c->max_misfit_chi2)) return HM_WINDOW_MISFIT;

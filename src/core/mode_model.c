@@ -271,6 +271,17 @@ static hm_status root_with_slope(hm_mode_model m, double lambda, double v_kmh, d
   return HM_OK;
 }
 
+/* The Gauss-Newton step in lambda of the weighted misfit of p from the measured mode, kept from taking lambda to or
+ * below 0 (at most half of it down, half plus 0.01 up); 0 if the sensitivities vanish or are not finite. */
+static int gauss_newton_step(const root_point *p, double lambda, double sigma_m, double e_sigma, double w_m,
+                             double e_w, double *step) {
+  const double jr = p->ds / e_sigma, ji = p->dw / e_w, rr = (p->s - sigma_m) / e_sigma, ri = (p->w - w_m) / e_w;
+  const double jj = jr * jr + ji * ji;
+  if (!(jj > 0.0) || !isfinite(jj)) return 0;
+  *step = fmax(fmin(-(jr * rr + ji * ri) / jj, 0.5 * lambda + 0.01), -0.5 * lambda);
+  return 1;
+}
+
 /* The inversion's result at its last point p (the misfit's sensitivities give the error, inversion.h's). */
 static void inversion_result(const root_point *p, double lambda, double sigma_m, double e_sigma, double w_m, double e_w,
                              unsigned iterations, hm_conicity_inversion *out) {
@@ -309,11 +320,8 @@ hm_status hm_mode_model_invert(hm_mode_model m, double speed_kmh, double sigma_m
   for (unsigned it = 1; it <= max_iter; ++it) {
     root_point p;
     if (root_with_slope(m, lambda, speed_kmh, e_sigma, e_w, &sr, &wr, &p) != HM_OK) return HM_ENOCONV;
-    const double jr = p.ds / e_sigma, ji = p.dw / e_w, rr = (p.s - sigma_m) / e_sigma, ri = (p.w - w_m) / e_w;
-    const double jj = jr * jr + ji * ji;
-    if (!(jj > 0.0) || !isfinite(jj)) return HM_ENOCONV;
-    double step = -(jr * rr + ji * ri) / jj;
-    step = fmax(fmin(step, 0.5 * lambda + 0.01), -0.5 * lambda); /* keep lambda positive */
+    double step;
+    if (!gauss_newton_step(&p, lambda, sigma_m, e_sigma, w_m, e_w, &step)) return HM_ENOCONV;
     lambda += step;
     if (fabs(step) > tol) continue;
     if (!(lambda > 0.0 && lambda < 10.0)) return HM_ENOCONV;
@@ -369,11 +377,8 @@ hm_status hm_mode_model_invert_reading(hm_mode_model m, unsigned poles, double s
   for (unsigned it = 1; it <= max_iter; ++it) {
     root_point p;
     if (reading_with_slope(m, poles, lambda, speed_kmh, &ref, th1, th2, &have, &p) != HM_OK) return HM_ENOCONV;
-    const double jr = p.ds / e_sigma, ji = p.dw / e_w, rr = (p.s - sigma_m) / e_sigma, ri = (p.w - w_m) / e_w;
-    const double jj = jr * jr + ji * ji;
-    if (!(jj > 0.0) || !isfinite(jj)) return HM_ENOCONV;
-    double step = -(jr * rr + ji * ri) / jj;
-    step = fmax(fmin(step, 0.5 * lambda + 0.01), -0.5 * lambda);
+    double step;
+    if (!gauss_newton_step(&p, lambda, sigma_m, e_sigma, w_m, e_w, &step)) return HM_ENOCONV;
     if (fabs(step) > tol * fmax(lambda, 1.0)) {
       lambda += step;
       continue;
@@ -637,6 +642,9 @@ static hm_status reading_fit(hm_mode_model m, double conicity, double v_kmh, uns
   mean /= (double)n;
   if (!(mean > 0.0) || !isfinite(mean)) return HM_ENONFINITE;
   for (size_t k = 0; k < n; ++k) m->rd_p[k] = m->rd_p[k] / mean + HM_MODE_MODEL_READING_FLOOR;
+  /* the roots at this conicity and speed: starts for a fit, and the read pair's own root */
+  double re[NMAX], im[NMAX];
+  if ((st = hm_system_eig(&m->sys, hm_mps_from_kmh(v_kmh), re, im, NULL)) != HM_OK) return st;
   const hm_whittle_data d = {m->rd_w, m->rd_u, m->rd_p, n, T};
   const double w_lo = 2.0 * HM_PI * m->band_lo_hz, w_hi = 2.0 * HM_PI * m->band_hi_hz;
   enum { MAX_STARTS = 4 + NMAX / 2 };
@@ -649,8 +657,8 @@ static hm_status reading_fit(hm_mode_model m, double conicity, double v_kmh, uns
     found = choose_fit(&d, 1, starts, 1, NULL, w_lo, w_hi, th1);
   }
   if (!found) {
-    /* three widths at the spectrum's peak (a smooth peak's fit may settle off it from a narrow start), the reference,
-     * and every oscillatory root in the band */
+    /* without a reference: three widths at the spectrum's peak (a smooth peak's fit may settle off it from a narrow
+     * start) and every oscillatory root in the band; with one: the reference and the peak */
     hm_whittle_cold_start(&d, 2, -0.7, starts[ns++]);
     hm_whittle_cold_start(&d, 2, -4.0, starts[ns++]);
     hm_whittle_cold_start(&d, 2, -10.0, starts[ns++]);
@@ -665,8 +673,7 @@ static hm_status reading_fit(hm_mode_model m, double conicity, double v_kmh, uns
       if (at > 0.0 && isfinite(at)) starts[0][HM_W_C0] += log(m->rd_p[kr] / at);
       ns = 2; /* and starts[1], the cold one at the peak */
     }
-    double re[NMAX], im[NMAX];
-    if (!ref && hm_system_eig(&m->sys, hm_mps_from_kmh(v_kmh), re, im, NULL) == HM_OK)
+    if (!ref)
       for (size_t i = 0; i < m->sys.dim && ns < MAX_STARTS; ++i) {
         if (!(im[i] > w_lo && im[i] < w_hi)) continue;
         memcpy(starts[ns], starts[1], sizeof starts[0]);
@@ -691,11 +698,9 @@ static hm_status reading_fit(hm_mode_model m, double conicity, double v_kmh, uns
   const int second = poles == 2 && fabs(th2[HM_W_SIGMA2]) < fabs(th2[HM_W_SIGMA]); /* the less damped (modal.c) */
   double s, ww;
   pair_of(th, second, &s, &ww);
-  /* a stationary spectrum tells |sigma| alone; where the model is unstable (beyond its Hopf conicity at this speed)
-   * there is none to read: the reading is given growing (+|sigma|), so that no measured (decaying) reading is
-   * explained there by the mirror image of the stable side */
-  double re[NMAX], im[NMAX];
-  if ((st = hm_system_eig(&m->sys, hm_mps_from_kmh(v_kmh), re, im, NULL)) != HM_OK) return st;
+  /* a stationary spectrum tells |sigma| alone; where the root the read pair follows is unstable there is none to
+   * read: the reading is given growing (+|sigma|), so that no measured (decaying) reading is explained there by the
+   * mirror image of the stable side */
   size_t kf = m->sys.dim; /* the oscillatory root the read pair follows: nearest it in frequency */
   for (size_t i = 0; i < m->sys.dim; ++i)
     if (im[i] > 0.0 && (kf == m->sys.dim || fabs(im[i] - ww) < fabs(im[kf] - ww))) kf = i;
