@@ -8,6 +8,7 @@
 #include <string.h>
 
 #include "hunting_monitor/linear.h"
+#include "validate.h"
 
 /* A flag raised at once and cleared only after its condition has been false for HM_ALARM_FLAG_CLEAR_S (alarm.h). */
 typedef struct {
@@ -167,44 +168,35 @@ void hm_alarm_config_default(hm_alarm_config *c) {
 }
 
 hm_status hm_alarm_config_validate(const hm_alarm_config *c, char *why, size_t len) {
-  const char *field = NULL, *rule = NULL;
-  double got = 0.0;
   if (!c) return HM_EINVAL;
-  if (!(c->warn_amplitude_fraction > 0.0 && c->warn_amplitude_fraction < 1.0))
-    field = "warn_amplitude_fraction", rule = "must be in (0, 1)", got = c->warn_amplitude_fraction;
-  else if (!(c->warn_speed_margin_kmh >= 0.0 && c->warn_speed_margin_kmh <= 500.0))
-    field = "warn_speed_margin_kmh", rule = "must be in [0, 500]", got = c->warn_speed_margin_kmh;
-  else if (!(c->watch_speed_margin_kmh >= c->warn_speed_margin_kmh && c->watch_speed_margin_kmh <= 500.0))
-    field = "watch_speed_margin_kmh", rule = "must be at least warn_speed_margin_kmh and at most 500",
-    got = c->watch_speed_margin_kmh;
-  else if (!(c->hysteresis_kmh >= 0.0 && c->hysteresis_kmh <= 100.0))
-    field = "hysteresis_kmh", rule = "must be in [0, 100]", got = c->hysteresis_kmh;
-  else if (!(c->hysteresis_amplitude_fraction >= 0.0 && c->hysteresis_amplitude_fraction < c->warn_amplitude_fraction))
-    field = "hysteresis_amplitude_fraction", rule = "must be at least 0 and below warn_amplitude_fraction",
-    got = c->hysteresis_amplitude_fraction;
-  else if (!(c->min_hold_s >= 0.0 && c->min_hold_s <= 3600.0))
-    field = "min_hold_s", rule = "must be in [0, 3600]", got = c->min_hold_s;
-  else if (!(c->conicity_max_se > 0.0 && c->conicity_max_se <= 1.0))
-    field = "conicity_max_se", rule = "must be in (0, 1]", got = c->conicity_max_se;
-  else if (!(c->conicity_fallback >= 0.0 && c->conicity_fallback <= 10.0))
-    field = "conicity_fallback", rule = "must be in [0, 10]", got = c->conicity_fallback;
-  else if (!(c->conicity_prior_low >= 0.0 && c->conicity_prior_low <= 10.0))
-    field = "conicity_prior_low", rule = "must be in [0, 10]", got = c->conicity_prior_low;
-  else if (!(c->conicity_prior_high >= 0.0 && c->conicity_prior_high <= 10.0))
-    field = "conicity_prior_high", rule = "must be in [0, 10]", got = c->conicity_prior_high;
-  else if (!(c->blind_fraction > 0.0 && c->blind_fraction <= 1.0))
-    field = "blind_fraction", rule = "must be in (0, 1]", got = c->blind_fraction;
-  else if (!(c->release_s >= 0.0 && c->release_s <= 3600.0))
-    field = "release_s", rule = "must be in [0, 3600]", got = c->release_s;
-  else if (!(c->release_amplitude_fraction > 0.0 && c->release_amplitude_fraction <= 1.0))
-    field = "release_amplitude_fraction", rule = "must be in (0, 1]", got = c->release_amplitude_fraction;
-  else if ((c->conicity_prior_low == 0.0) != (c->conicity_prior_high == 0.0) ||
-           (c->conicity_prior_high != 0.0 && !(c->conicity_prior_high > c->conicity_prior_low)))
-    field = "conicity_prior_high", rule = "must be above conicity_prior_low (or both 0: the fallback -+ 0.03)",
-    got = c->conicity_prior_high;
-  if (!field) return HM_OK;
-  if (why && len) snprintf(why, len, "%s: out of range: %s (got %g)", field, rule, got);
-  return HM_EDOMAIN;
+  const hm_field_check f[] = {
+      {"warn_amplitude_fraction", c->warn_amplitude_fraction, HM_RULE_OPEN, 0.0, 1.0},
+      {"warn_speed_margin_kmh", c->warn_speed_margin_kmh, HM_RULE_RANGE, 0.0, 500.0},
+      {"watch_speed_margin_kmh", c->watch_speed_margin_kmh, HM_RULE_RANGE, 0.0, 500.0},
+      {"hysteresis_kmh", c->hysteresis_kmh, HM_RULE_RANGE, 0.0, 100.0},
+      {"hysteresis_amplitude_fraction", c->hysteresis_amplitude_fraction, HM_RULE_RANGE, 0.0, 1.0},
+      {"min_hold_s", c->min_hold_s, HM_RULE_RANGE, 0.0, 3600.0},
+      {"use_conicity_estimate", (double)c->use_conicity_estimate, HM_RULE_FLAG, 0.0, 0.0},
+      {"conicity_max_se", c->conicity_max_se, HM_RULE_RANGE_OPEN, 0.0, 1.0},
+      {"conicity_fallback", c->conicity_fallback, HM_RULE_RANGE, 0.0, 10.0},
+      {"conicity_prior_low", c->conicity_prior_low, HM_RULE_RANGE, 0.0, 10.0},
+      {"conicity_prior_high", c->conicity_prior_high, HM_RULE_RANGE, 0.0, 10.0},
+      {"blind_fraction", c->blind_fraction, HM_RULE_RANGE_OPEN, 0.0, 1.0},
+      {"release_s", c->release_s, HM_RULE_RANGE, 0.0, 3600.0},
+      {"release_amplitude_fraction", c->release_amplitude_fraction, HM_RULE_RANGE_OPEN, 0.0, 1.0}};
+  const hm_status st = hm_check_fields(f, HM_COUNT_OF(f), why, len);
+  if (st != HM_OK) return st;
+  if (!(c->watch_speed_margin_kmh >= c->warn_speed_margin_kmh))
+    return hm_reject(why, len, "watch_speed_margin_kmh", "must be at least warn_speed_margin_kmh",
+                     c->watch_speed_margin_kmh);
+  if (!(c->hysteresis_amplitude_fraction < c->warn_amplitude_fraction))
+    return hm_reject(why, len, "hysteresis_amplitude_fraction", "must be below warn_amplitude_fraction",
+                     c->hysteresis_amplitude_fraction);
+  if ((c->conicity_prior_low == 0.0) != (c->conicity_prior_high == 0.0) ||
+      (c->conicity_prior_high != 0.0 && !(c->conicity_prior_high > c->conicity_prior_low)))
+    return hm_reject(why, len, "conicity_prior_high",
+                     "must be above conicity_prior_low (or both 0: the fallback -+ 0.03)", c->conicity_prior_high);
+  return HM_OK;
 }
 
 /* The Hopf speed at a conicity: the vehicle model's curve, or the wheelset's closed form. */

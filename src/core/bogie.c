@@ -29,16 +29,16 @@ hm_status hm_bogie_validate(const hm_bogie *b, char *why, size_t why_len) {
   hm_status st = hm_vehicle_validate(&b->wheelset, why, why_len);
   if (st != HM_OK) return st;
   const hm_field_check checks[] = {
-      {"bogie.frame_mass_kg", b->frame_mass_kg, HM_RULE_POSITIVE},
-      {"bogie.frame_yaw_inertia_kg_m2", b->frame_yaw_inertia_kg_m2, HM_RULE_POSITIVE},
-      {"bogie.half_wheelbase_m", b->half_wheelbase_m, HM_RULE_POSITIVE},
-      {"bogie.secondary_lat_stiffness_n_m", b->secondary_lat_stiffness_n_m, HM_RULE_NONNEG},
-      {"bogie.secondary_lat_damping_n_s_m", b->secondary_lat_damping_n_s_m, HM_RULE_NONNEG},
-      {"bogie.airspring_long_stiffness_n_m", b->airspring_long_stiffness_n_m, HM_RULE_NONNEG},
-      {"bogie.airspring_half_distance_m", b->airspring_half_distance_m, HM_RULE_POSITIVE},
-      {"bogie.yaw_damper_damping_n_s_m", b->yaw_damper_damping_n_s_m, HM_RULE_POSITIVE},
-      {"bogie.yaw_damper_stiffness_n_m", b->yaw_damper_stiffness_n_m, HM_RULE_POSITIVE},
-      {"bogie.yaw_damper_half_distance_m", b->yaw_damper_half_distance_m, HM_RULE_POSITIVE},
+      {"bogie.frame_mass_kg", b->frame_mass_kg, HM_RULE_POSITIVE, 0.0, 0.0},
+      {"bogie.frame_yaw_inertia_kg_m2", b->frame_yaw_inertia_kg_m2, HM_RULE_POSITIVE, 0.0, 0.0},
+      {"bogie.half_wheelbase_m", b->half_wheelbase_m, HM_RULE_POSITIVE, 0.0, 0.0},
+      {"bogie.secondary_lat_stiffness_n_m", b->secondary_lat_stiffness_n_m, HM_RULE_NONNEG, 0.0, 0.0},
+      {"bogie.secondary_lat_damping_n_s_m", b->secondary_lat_damping_n_s_m, HM_RULE_NONNEG, 0.0, 0.0},
+      {"bogie.airspring_long_stiffness_n_m", b->airspring_long_stiffness_n_m, HM_RULE_NONNEG, 0.0, 0.0},
+      {"bogie.airspring_half_distance_m", b->airspring_half_distance_m, HM_RULE_POSITIVE, 0.0, 0.0},
+      {"bogie.yaw_damper_damping_n_s_m", b->yaw_damper_damping_n_s_m, HM_RULE_POSITIVE, 0.0, 0.0},
+      {"bogie.yaw_damper_stiffness_n_m", b->yaw_damper_stiffness_n_m, HM_RULE_POSITIVE, 0.0, 0.0},
+      {"bogie.yaw_damper_half_distance_m", b->yaw_damper_half_distance_m, HM_RULE_POSITIVE, 0.0, 0.0},
   };
   return hm_check_fields(checks, sizeof checks / sizeof checks[0], why, why_len);
 }

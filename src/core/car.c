@@ -24,9 +24,9 @@ hm_status hm_car_validate(const hm_car *car, char *why, size_t why_len) {
   hm_status st = hm_bogie_validate(&car->bogie, why, why_len);
   if (st != HM_OK) return st;
   const hm_field_check checks[] = {
-      {"car.carbody_mass_kg", car->carbody_mass_kg, HM_RULE_POSITIVE},
-      {"car.carbody_yaw_inertia_kg_m2", car->carbody_yaw_inertia_kg_m2, HM_RULE_POSITIVE},
-      {"car.half_bogie_distance_m", car->half_bogie_distance_m, HM_RULE_POSITIVE},
+      {"car.carbody_mass_kg", car->carbody_mass_kg, HM_RULE_POSITIVE, 0.0, 0.0},
+      {"car.carbody_yaw_inertia_kg_m2", car->carbody_yaw_inertia_kg_m2, HM_RULE_POSITIVE, 0.0, 0.0},
+      {"car.half_bogie_distance_m", car->half_bogie_distance_m, HM_RULE_POSITIVE, 0.0, 0.0},
   };
   return hm_check_fields(checks, sizeof checks / sizeof checks[0], why, why_len);
 }

@@ -3,6 +3,7 @@
 
 #include <math.h>
 #include <stdio.h>
+#include "validate.h"
 
 void hm_clock_config_default(hm_clock_config *cfg) {
   if (!cfg) return;
@@ -13,16 +14,10 @@ void hm_clock_config_default(hm_clock_config *cfg) {
 
 hm_status hm_clock_config_validate(const hm_clock_config *cfg, char *why, size_t why_len) {
   if (!cfg) return HM_EINVAL;
-  const struct {
-    const char *name;
-    double v, max;
-  } f[] = {{"window_s", cfg->window_s, 3600.0}, {"max_step_s", cfg->max_step_s, 3600.0}, {"confirm_s", cfg->confirm_s, 60.0}};
-  for (size_t i = 0; i < sizeof f / sizeof f[0]; ++i)
-    if (!(f[i].v > 0.0 && f[i].v <= f[i].max)) {
-      if (why && why_len) snprintf(why, why_len, "clock.%s: must be in (0, %g] (got %g)", f[i].name, f[i].max, f[i].v);
-      return HM_EDOMAIN;
-    }
-  return HM_OK;
+  const hm_field_check f[] = {{"clock.window_s", cfg->window_s, HM_RULE_RANGE_OPEN, 0.0, 3600.0},
+                              {"clock.max_step_s", cfg->max_step_s, HM_RULE_RANGE_OPEN, 0.0, 3600.0},
+                              {"clock.confirm_s", cfg->confirm_s, HM_RULE_RANGE_OPEN, 0.0, 60.0}};
+  return hm_check_fields(f, HM_COUNT_OF(f), why, why_len);
 }
 
 /* The offset and the window start again from one sample's receipt - stamp. */

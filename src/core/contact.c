@@ -3,6 +3,7 @@
 
 #include <math.h>
 #include <stdio.h>
+#include "validate.h"
 
 void hm_contact_config_default(hm_contact_config *cfg) {
   if (!cfg) return;
@@ -17,31 +18,18 @@ void hm_contact_config_default(hm_contact_config *cfg) {
 
 hm_status hm_contact_config_validate(const hm_contact_config *c, char *why, size_t len) {
   if (!c) return HM_EINVAL;
-  const struct {
-    const char *name;
-    double v, lo, hi;
-  } f[] = {{"r0_left_m", c->r0_left_m, 0.1, 1.0},
-           {"r0_right_m", c->r0_right_m, 0.1, 1.0},
-           {"measuring_circle_m", c->measuring_circle_m, 0.0, 0.2},
-           {"flange_back_distance_m", c->flange_back_distance_m, 0.5, 2.0},
-           {"gauge_m", c->gauge_m, 0.5, 2.0},
-           {"gauge_depth_m", c->gauge_depth_m, 0.001, 0.05},
-           {"inclination", c->inclination, 0.0, 0.1}};
-  for (size_t i = 0; i < sizeof f / sizeof f[0]; ++i)
-    if (!(f[i].v >= f[i].lo && f[i].v <= f[i].hi)) {
-      if (why && len) snprintf(why, len, "%s: must be in [%g, %g] (got %g)", f[i].name, f[i].lo, f[i].hi, f[i].v);
-      return HM_EDOMAIN;
-    }
-  if (c->include_roll != 0 && c->include_roll != 1) {
-    if (why && len) snprintf(why, len, "include_roll: must be 0 or 1 (got %d)", c->include_roll);
-    return HM_EDOMAIN;
-  }
-  if (!(c->gauge_m > c->flange_back_distance_m)) {
-    if (why && len)
-      snprintf(why, len, "gauge_m: must exceed flange_back_distance_m (got %g and %g)", c->gauge_m,
-               c->flange_back_distance_m);
-    return HM_EDOMAIN;
-  }
+  const hm_field_check f[] = {{"r0_left_m", c->r0_left_m, HM_RULE_RANGE, HM_R0_MIN_M, HM_R0_MAX_M},
+                              {"r0_right_m", c->r0_right_m, HM_RULE_RANGE, HM_R0_MIN_M, HM_R0_MAX_M},
+                              {"measuring_circle_m", c->measuring_circle_m, HM_RULE_RANGE, 0.0, 0.2},
+                              {"flange_back_distance_m", c->flange_back_distance_m, HM_RULE_RANGE, 0.5, 2.0},
+                              {"gauge_m", c->gauge_m, HM_RULE_RANGE, 0.5, 2.0},
+                              {"gauge_depth_m", c->gauge_depth_m, HM_RULE_RANGE, 0.001, 0.05},
+                              {"inclination", c->inclination, HM_RULE_RANGE, 0.0, 0.1},
+                              {"include_roll", (double)c->include_roll, HM_RULE_FLAG, 0.0, 0.0}};
+  const hm_status st = hm_check_fields(f, HM_COUNT_OF(f), why, len);
+  if (st != HM_OK) return st;
+  if (!(c->gauge_m > c->flange_back_distance_m))
+    return hm_reject(why, len, "gauge_m", "must exceed flange_back_distance_m", c->gauge_m);
   return HM_OK;
 }
 

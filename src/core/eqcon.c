@@ -4,6 +4,7 @@
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
+#include "validate.h"
 
 #define PI 3.14159265358979323846
 
@@ -16,17 +17,10 @@ void hm_eqcon_config_default(hm_eqcon_config *cfg) {
 
 hm_status hm_eqcon_config_validate(const hm_eqcon_config *cfg, char *why, size_t why_len) {
   if (!cfg) return HM_EINVAL;
-  const char *field = NULL, *rule = NULL;
-  double got = 0.0;
-  if (!(cfg->r0_m > 0.0 && cfg->r0_m <= 5.0))
-    field = "r0_m", rule = "must be in (0, 5]", got = cfg->r0_m;
-  else if (!(cfg->contact_distance_m > 0.0 && cfg->contact_distance_m <= 5.0))
-    field = "contact_distance_m", rule = "must be in (0, 5]", got = cfg->contact_distance_m;
-  else if (!(cfg->tol >= 1e-14 && cfg->tol <= 1e-2))
-    field = "tol", rule = "must be in [1e-14, 1e-2]", got = cfg->tol;
-  if (!field) return HM_OK;
-  if (why && why_len) snprintf(why, why_len, "%s: %s (got %g)", field, rule, got);
-  return HM_EDOMAIN;
+  const hm_field_check f[] = {{"r0_m", cfg->r0_m, HM_RULE_RANGE, HM_R0_MIN_M, HM_R0_MAX_M},
+                              {"contact_distance_m", cfg->contact_distance_m, HM_RULE_RANGE, 0.5, 2.5},
+                              {"tol", cfg->tol, HM_RULE_RANGE, 1e-14, 1e-2}};
+  return hm_check_fields(f, HM_COUNT_OF(f), why, why_len);
 }
 
 /* The restoring equilibrium nearest y = 0; 0 and *y_eq, or -1. */

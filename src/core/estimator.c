@@ -11,6 +11,7 @@
 #include "biquad.h"
 #include "select.h"
 #include "hunting_monitor/criteria.h"
+#include "validate.h"
 
 enum { BAND_SECTIONS = 4 };
 
@@ -94,63 +95,41 @@ void hm_estimator_config_default(hm_estimator_config *c) {
   c->max_accel_mps2 = 500.0;
 }
 
-static hm_status bad(char *why, size_t len, const char *field, const char *reason, double got) {
-  if (why && len) snprintf(why, len, "%s: %s (got %g)", field, reason, got);
-  return HM_EDOMAIN;
-}
-
 hm_status hm_estimator_config_validate(const hm_estimator_config *c, char *why, size_t len) {
   if (!c) return HM_EINVAL;
   const double fs = c->sample_rate_hz;
-  const struct {
-    const char *name;
-    double v;
-  } positive[] = {{"sample_rate_hz", fs},
-                  {"band_low_hz", c->band_low_hz},
-                  {"tracking_time_s", c->tracking_time_s},
-                  {"rms_window_m", c->rms_window_m},
-                  {"rms_limit_mps2", c->rms_limit_mps2},
-                  {"peaks_band_low_hz", c->peaks_band_low_hz},
-                  {"peaks_limit_mps2", c->peaks_limit_mps2},
-                  {"max_gap_s", c->max_gap_s},
-                  {"accel_timeout_s", c->accel_timeout_s},
-                  {"speed_timeout_s", c->speed_timeout_s},
-                  {"max_speed_kmh", c->max_speed_kmh},
-                  {"max_speed_rate_kmh_s", c->max_speed_rate_kmh_s},
-                  {"max_accel_mps2", c->max_accel_mps2}};
-  for (size_t i = 0; i < sizeof positive / sizeof positive[0]; ++i)
-    if (!isfinite(positive[i].v) || positive[i].v <= 0.0)
-      return bad(why, len, positive[i].name, "must be finite and > 0", positive[i].v);
-  if (fs < 100.0 || fs > 5000.0) return bad(why, len, "sample_rate_hz", "must be in 100..5000", fs);
+  /* the upper ends of tracking_time_s, rms_window_m and the gaps bound the buffers sized from them (estimator.h
+   * states the memory they bound) */
+  const hm_field_check f[] = {
+      {"sample_rate_hz", fs, HM_RULE_RANGE, 100.0, 5000.0},
+      {"band_low_hz", c->band_low_hz, HM_RULE_POSITIVE, 0.0, 0.0},
+      {"tracking_time_s", c->tracking_time_s, HM_RULE_RANGE_OPEN, 0.0, HM_ESTIMATOR_MAX_TRACKING_S},
+      {"rms_window_m", c->rms_window_m, HM_RULE_RANGE_OPEN, 0.0, HM_ESTIMATOR_MAX_RMS_WINDOW_M},
+      {"rms_limit_mps2", c->rms_limit_mps2, HM_RULE_POSITIVE, 0.0, 0.0},
+      {"peaks_band_low_hz", c->peaks_band_low_hz, HM_RULE_POSITIVE, 0.0, 0.0},
+      {"peaks_limit_mps2", c->peaks_limit_mps2, HM_RULE_POSITIVE, 0.0, 0.0},
+      {"max_gap_s", c->max_gap_s, HM_RULE_RANGE_OPEN, 0.0, 10.0},
+      {"accel_timeout_s", c->accel_timeout_s, HM_RULE_RANGE_OPEN, 0.0, 60.0},
+      {"speed_timeout_s", c->speed_timeout_s, HM_RULE_RANGE_OPEN, 0.0, 60.0},
+      {"max_speed_kmh", c->max_speed_kmh, HM_RULE_POSITIVE, 0.0, 0.0},
+      {"max_speed_rate_kmh_s", c->max_speed_rate_kmh_s, HM_RULE_POSITIVE, 0.0, 0.0},
+      {"max_accel_mps2", c->max_accel_mps2, HM_RULE_POSITIVE, 0.0, 0.0},
+      {"max_speed_jump_kmh", c->max_speed_jump_kmh, HM_RULE_RANGE, 0.0, 100.0},
+      {"peaks_count", (double)c->peaks_count, HM_RULE_RANGE, 1.0, 1000.0},
+      {"displacement_limit_m", c->displacement_limit_m, HM_RULE_RANGE, 0.0, 0.05}};
+  const hm_status st = hm_check_fields(f, HM_COUNT_OF(f), why, len);
+  if (st != HM_OK) return st;
   if (!(c->band_high_hz > c->band_low_hz) || !(c->band_high_hz < 0.45 * fs))
-    return bad(why, len, "band_high_hz", "must be above band_low_hz and below 0.45 sample_rate_hz", c->band_high_hz);
+    return hm_reject(why, len, "band_high_hz", "must be above band_low_hz and below 0.45 sample_rate_hz",
+                     c->band_high_hz);
   if (!(c->peaks_band_high_hz > c->peaks_band_low_hz) || !(c->peaks_band_high_hz < 0.45 * fs))
-    return bad(why, len, "peaks_band_high_hz", "must be above peaks_band_low_hz and below 0.45 sample_rate_hz",
-               c->peaks_band_high_hz);
+    return hm_reject(why, len, "peaks_band_high_hz", "must be above peaks_band_low_hz and below 0.45 sample_rate_hz",
+                     c->peaks_band_high_hz);
   if (c->tracking_time_s * c->band_low_hz < 1.0)
-    return bad(why, len, "tracking_time_s", "must hold at least one period of band_low_hz", c->tracking_time_s);
-  if (!(c->max_speed_jump_kmh >= 0.0 && c->max_speed_jump_kmh <= 100.0))
-    return bad(why, len, "max_speed_jump_kmh", "must be in 0..100", c->max_speed_jump_kmh);
+    return hm_reject(why, len, "tracking_time_s", "must hold at least one period of band_low_hz", c->tracking_time_s);
   if (c->measurement_point != HM_POINT_WHEELSET && c->measurement_point != HM_POINT_BOGIE_FRAME)
-    return bad(why, len, "measurement_point", "must be wheelset or bogie_frame", (double)c->measurement_point);
-  if (c->peaks_count < 1 || c->peaks_count > 1000) return bad(why, len, "peaks_count", "must be 1..1000", c->peaks_count);
-  if (!(c->displacement_limit_m >= 0.0 && c->displacement_limit_m <= 0.05))
-    return bad(why, len, "displacement_limit_m", "must be in [0, 0.05] (0: off)", c->displacement_limit_m);
-  if (c->max_gap_s < 2.0 / fs) return bad(why, len, "max_gap_s", "must be at least two sample periods", c->max_gap_s);
-  /* upper bounds: the buffers are sized from these (estimator.h states the memory they bound) */
-  const struct {
-    const char *name;
-    double v, max;
-  } bounded[] = {{"tracking_time_s", c->tracking_time_s, HM_ESTIMATOR_MAX_TRACKING_S},
-                 {"rms_window_m", c->rms_window_m, HM_ESTIMATOR_MAX_RMS_WINDOW_M},
-                 {"max_gap_s", c->max_gap_s, 10.0},
-                 {"accel_timeout_s", c->accel_timeout_s, 60.0},
-                 {"speed_timeout_s", c->speed_timeout_s, 60.0}};
-  for (size_t i = 0; i < sizeof bounded / sizeof bounded[0]; ++i)
-    if (bounded[i].v > bounded[i].max) {
-      if (why && len) snprintf(why, len, "%s: must be at most %g (got %g)", bounded[i].name, bounded[i].max, bounded[i].v);
-      return HM_EDOMAIN;
-    }
+    return hm_reject(why, len, "measurement_point", "must be wheelset or bogie_frame", (double)c->measurement_point);
+  if (c->max_gap_s < 2.0 / fs) return hm_reject(why, len, "max_gap_s", "must be at least two sample periods", c->max_gap_s);
   return HM_OK;
 }
 

@@ -9,6 +9,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include "validate.h"
 
 
 enum { MAX_CANDIDATES = 32, MAX_DIVISOR = 12 };
@@ -28,22 +29,14 @@ void hm_lines_config_default(hm_lines_config *c) {
 }
 
 hm_status hm_lines_config_validate(const hm_lines_config *c, char *why, size_t len) {
-  const char *field = NULL, *rule = NULL;
-  double got = 0.0;
   if (!c) return HM_EINVAL;
-  if (!(c->candidate_ratio >= 3.0 && c->candidate_ratio <= 1e4))
-    field = "candidate_ratio", rule = "must be in 3..1e4", got = c->candidate_ratio;
-  else if (!(c->background_halfwidth_hz >= 0.05 && c->background_halfwidth_hz <= 5.0))
-    field = "background_halfwidth_hz", rule = "must be in 0.05..5", got = c->background_halfwidth_hz;
-  else if (!(c->min_fundamental_hz >= 0.1 && c->min_fundamental_hz <= 100.0))
-    field = "min_fundamental_hz", rule = "must be in 0.1..100", got = c->min_fundamental_hz;
-  else if (c->min_harmonics < 2 || c->min_harmonics > 20)
-    field = "min_harmonics", rule = "must be 2..20", got = c->min_harmonics;
-  else if (!(c->leakage > 0.0 && c->leakage <= 1.0))
-    field = "leakage", rule = "must be in (0, 1]", got = c->leakage;
-  if (!field) return HM_OK;
-  if (why && len) snprintf(why, len, "%s: %s (got %g)", field, rule, got);
-  return HM_EDOMAIN;
+  const hm_field_check f[] = {
+      {"candidate_ratio", c->candidate_ratio, HM_RULE_RANGE, 3.0, 1e4},
+      {"background_halfwidth_hz", c->background_halfwidth_hz, HM_RULE_RANGE, 0.05, 5.0},
+      {"min_fundamental_hz", c->min_fundamental_hz, HM_RULE_RANGE, 0.1, 100.0},
+      {"min_harmonics", (double)c->min_harmonics, HM_RULE_RANGE, 2.0, 20.0},
+      {"leakage", c->leakage, HM_RULE_RANGE_OPEN, 0.0, 1.0}};
+  return hm_check_fields(f, HM_COUNT_OF(f), why, len);
 }
 
 hm_status hm_lines_create(const hm_lines_config *cfg, size_t max_bins, hm_lines *out, char *why, size_t len) {

@@ -7,6 +7,7 @@
 #include <string.h>
 
 #include "hunting_monitor/linear.h"
+#include "validate.h"
 
 typedef struct {
   double t_end_s, speed_kmh;
@@ -75,25 +76,18 @@ void hm_margin_config_default(hm_margin_config *c) {
 
 hm_status hm_margin_config_validate(const hm_margin_config *c, char *why, size_t len) {
   if (!c) return HM_EINVAL;
-  const struct {
-    const char *name;
-    double v, lo, hi;
-  } f[] = {{"frequency_model_error", c->frequency_model_error, 0.0, 0.5},
-           {"decay_rate_model_error", c->decay_rate_model_error, 0.0, 1.0},
-           {"max_speed_spread_kmh", c->max_speed_spread_kmh, 0.0, 200.0},
-           {"min_speed_kmh", c->min_speed_kmh, 0.0, 1000.0},
-           {"memory_s", c->memory_s, 1.0, 1e6},
-           {"min_speed_span_kmh", c->min_speed_span_kmh, 1.0, 1000.0},
-           {"max_extrapolation_kmh", c->max_extrapolation_kmh, 1.0, 1000.0},
-           {"interval_z", c->interval_z, 0.5, 10.0},
-           {"max_misfit_chi2", c->max_misfit_chi2, 1.0, 1e6},
-           {"change_z", c->change_z, 1.0, 100.0}};
-  for (size_t i = 0; i < sizeof f / sizeof f[0]; ++i)
-    if (!(f[i].v >= f[i].lo && f[i].v <= f[i].hi)) {
-      if (why && len) snprintf(why, len, "%s: must be in %g..%g (got %g)", f[i].name, f[i].lo, f[i].hi, f[i].v);
-      return HM_EDOMAIN;
-    }
-  return HM_OK;
+  const hm_field_check f[] = {
+      {"frequency_model_error", c->frequency_model_error, HM_RULE_RANGE, 0.0, 0.5},
+      {"decay_rate_model_error", c->decay_rate_model_error, HM_RULE_RANGE, 0.0, 1.0},
+      {"max_speed_spread_kmh", c->max_speed_spread_kmh, HM_RULE_RANGE, 0.0, 200.0},
+      {"min_speed_kmh", c->min_speed_kmh, HM_RULE_RANGE, 0.0, 1000.0},
+      {"memory_s", c->memory_s, HM_RULE_RANGE, 1.0, 1e6},
+      {"min_speed_span_kmh", c->min_speed_span_kmh, HM_RULE_RANGE, 1.0, 1000.0},
+      {"max_extrapolation_kmh", c->max_extrapolation_kmh, HM_RULE_RANGE, 1.0, 1000.0},
+      {"interval_z", c->interval_z, HM_RULE_RANGE, 0.5, 10.0},
+      {"max_misfit_chi2", c->max_misfit_chi2, HM_RULE_RANGE, 1.0, 1e6},
+      {"change_z", c->change_z, HM_RULE_RANGE, 1.0, 100.0}};
+  return hm_check_fields(f, HM_COUNT_OF(f), why, len);
 }
 
 hm_status hm_margin_create(const hm_margin_config *cfg, const hm_vehicle *veh, hm_margin *out, char *why, size_t len) {

@@ -11,6 +11,7 @@
 #include "hunting_monitor/lines.h"
 #include "hunting_monitor/order_lines.h"
 #include "whittle.h"
+#include "validate.h"
 
 enum { NPM = HM_WHITTLE_MAX_NP };
 /* The two-pair fit: at most this many scoring steps (a second pair that needs more is not there), the one pair's
@@ -80,27 +81,23 @@ static hm_lines_config lines_config(const hm_modal_config *c) {
   return lc;
 }
 
-static hm_status bad(char *why, size_t len, const char *field, const char *reason, double got) {
-  if (why && len) snprintf(why, len, "%s: %s (got %g)", field, reason, got);
-  return HM_EDOMAIN;
-}
-
 hm_status hm_modal_config_validate(const hm_modal_config *c, char *why, size_t len) {
   if (!c) return HM_EINVAL;
-  if (!(c->window_s >= 5.0 && c->window_s <= 300.0)) return bad(why, len, "window_s", "must be in 5..300", c->window_s);
+  const hm_field_check f[] = {{"window_s", c->window_s, HM_RULE_RANGE, 5.0, 300.0},
+                              {"decimated_rate_hz", c->decimated_rate_hz, HM_RULE_RANGE, 20.0, 1000.0},
+                              {"band_low_hz", c->band_low_hz, HM_RULE_RANGE_OPEN, 2.0, 500.0},
+                              {"tol", c->tol, HM_RULE_OPEN, 0.0, 1e-2},
+                              {"max_iter", (double)c->max_iter, HM_RULE_RANGE, 1.0, 10000.0},
+                              {"reject_lines", (double)c->reject_lines, HM_RULE_FLAG, 0.0, 0.0}};
+  const hm_status st = hm_check_fields(f, HM_COUNT_OF(f), why, len);
+  if (st != HM_OK) return st;
   if (!(c->min_window_s >= 2.0 && c->min_window_s <= c->window_s))
-    return bad(why, len, "min_window_s", "must be in 2..window_s", c->min_window_s);
-  if (!(c->decimated_rate_hz >= 20.0 && c->decimated_rate_hz <= 1000.0))
-    return bad(why, len, "decimated_rate_hz", "must be in 20..1000", c->decimated_rate_hz);
-  if (!(c->band_low_hz > 2.0)) return bad(why, len, "band_low_hz", "must be above 2 Hz (the high-pass)", c->band_low_hz);
+    return hm_reject(why, len, "min_window_s", "must be in [2, window_s]", c->min_window_s);
   if (!(c->band_high_hz > c->band_low_hz + 2.0 && c->band_high_hz <= 0.4 * c->decimated_rate_hz))
-    return bad(why, len, "band_high_hz", "must be 2 Hz above band_low_hz and at most 0.4 decimated_rate_hz",
-               c->band_high_hz);
+    return hm_reject(why, len, "band_high_hz", "must be 2 Hz above band_low_hz and at most 0.4 decimated_rate_hz",
+                     c->band_high_hz);
   if (!(c->fit_interval_s >= 0.01 && c->fit_interval_s <= c->window_s))
-    return bad(why, len, "fit_interval_s", "must be in 0.01..window_s", c->fit_interval_s);
-  if (!(c->tol > 0.0 && c->tol < 1e-2)) return bad(why, len, "tol", "must be in (0, 0.01)", c->tol);
-  if (c->max_iter < 1 || c->max_iter > 10000) return bad(why, len, "max_iter", "must be 1..10000", c->max_iter);
-  if (c->reject_lines != 0 && c->reject_lines != 1) return bad(why, len, "reject_lines", "must be 0 or 1", c->reject_lines);
+    return hm_reject(why, len, "fit_interval_s", "must be in [0.01, window_s]", c->fit_interval_s);
   const hm_lines_config lc = lines_config(c);
   char tmp[160] = "";
   if (hm_lines_config_validate(&lc, tmp, sizeof tmp) != HM_OK) {
@@ -154,7 +151,8 @@ hm_status hm_modal_create(const hm_modal_config *cfg, double fs, hm_modal *out, 
   if (st != HM_OK) return st;
   unsigned r;
   double fd;
-  if (!rate_plan(cfg, fs, &r, &fd)) return bad(why, len, "sample_rate_hz", "must be in 100..5000 and above decimated_rate_hz", fs);
+  if (!rate_plan(cfg, fs, &r, &fd))
+    return hm_reject(why, len, "sample_rate_hz", "must be in [100, 5000] and above decimated_rate_hz", fs);
   hm_modal m = calloc(1, sizeof *m);
   if (!m) return HM_ENOMEM;
   m->cfg = *cfg;

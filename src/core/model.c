@@ -34,17 +34,17 @@ hm_status hm_vehicle_validate(const hm_vehicle *veh, char *why, size_t why_len) 
     return HM_EINVAL;
   }
   const hm_field_check checks[] = {
-      {"vehicle.mass_kg", veh->mass_kg, HM_RULE_POSITIVE},
-      {"vehicle.yaw_inertia_kg_m2", veh->yaw_inertia_kg_m2, HM_RULE_POSITIVE},
-      {"vehicle.contact_half_distance_m", veh->contact_half_distance_m, HM_RULE_POSITIVE},
-      {"vehicle.spring_half_distance_m", veh->spring_half_distance_m, HM_RULE_POSITIVE},
-      {"vehicle.rolling_radius_m", veh->rolling_radius_m, HM_RULE_POSITIVE},
-      {"vehicle.creep_long_n", veh->creep_long_n, HM_RULE_POSITIVE},
-      {"vehicle.creep_lat_n", veh->creep_lat_n, HM_RULE_POSITIVE},
-      {"vehicle.spring_ratio", veh->spring_ratio, HM_RULE_POSITIVE},
-      {"vehicle.kx_mn_m", veh->stiffness_long_n_m / 1e6, HM_RULE_POSITIVE},
-      {"vehicle.ky_mn_m", veh->stiffness_lat_n_m / 1e6, HM_RULE_NONNEG},
-      {"conicity.constant", veh->conicity.constant, HM_RULE_NONNEG},
+      {"vehicle.mass_kg", veh->mass_kg, HM_RULE_POSITIVE, 0.0, 0.0},
+      {"vehicle.yaw_inertia_kg_m2", veh->yaw_inertia_kg_m2, HM_RULE_POSITIVE, 0.0, 0.0},
+      {"vehicle.contact_half_distance_m", veh->contact_half_distance_m, HM_RULE_POSITIVE, 0.0, 0.0},
+      {"vehicle.spring_half_distance_m", veh->spring_half_distance_m, HM_RULE_POSITIVE, 0.0, 0.0},
+      {"vehicle.rolling_radius_m", veh->rolling_radius_m, HM_RULE_RANGE, HM_R0_MIN_M, HM_R0_MAX_M},
+      {"vehicle.creep_long_n", veh->creep_long_n, HM_RULE_POSITIVE, 0.0, 0.0},
+      {"vehicle.creep_lat_n", veh->creep_lat_n, HM_RULE_POSITIVE, 0.0, 0.0},
+      {"vehicle.spring_ratio", veh->spring_ratio, HM_RULE_POSITIVE, 0.0, 0.0},
+      {"vehicle.kx_mn_m", veh->stiffness_long_n_m / 1e6, HM_RULE_POSITIVE, 0.0, 0.0},
+      {"vehicle.ky_mn_m", veh->stiffness_lat_n_m / 1e6, HM_RULE_NONNEG, 0.0, 0.0},
+      {"conicity.constant", veh->conicity.constant, HM_RULE_NONNEG, 0.0, 0.0},
   };
   hm_status st = hm_check_fields(checks, sizeof checks / sizeof checks[0], why, why_len);
   if (st != HM_OK) return st;

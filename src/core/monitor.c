@@ -7,6 +7,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include "validate.h"
 
 /* Speed statistics per fit interval, so that the steady part of the window and its speed are known. */
 typedef struct {
@@ -71,20 +72,13 @@ hm_status hm_monitor_config_validate(const hm_monitor_config *c, char *why, size
   if (st == HM_OK) st = prefixed(hm_margin_config_validate(&c->margin, why, len), "margin", why, len);
   if (st == HM_OK) st = prefixed(hm_alarm_config_validate(&c->alarm, why, len), "alarm", why, len);
   if (st == HM_OK) st = hm_track_lines_config_validate(&c->track_lines, why, len); /* "track_lines." prefixed */
-  if (st == HM_OK && (c->table_n_conicity < 2 || c->table_n_conicity > 1000)) {
-    if (why && len) snprintf(why, len, "table_n_conicity: must be 2..1000 (got %zu)", c->table_n_conicity);
-    st = HM_EDOMAIN;
-  }
-  if (st == HM_OK && (!(c->table.tolerance_kmh > 0.0) || !(c->table.tolerance_m > 0.0) ||
-                      !isfinite(c->table.tolerance_kmh) || !isfinite(c->table.tolerance_m) ||
-                      (c->table.refine != 0 && c->table.refine != 1) || c->table.max_curves > 10000)) {
-    if (why && len)
-      snprintf(why, len, "table: tolerance_kmh and tolerance_m must be finite and > 0, refine 0 or 1, max_curves at "
-                         "most 10000 (got %g, %g, %d, %u)", c->table.tolerance_kmh, c->table.tolerance_m,
-               c->table.refine, c->table.max_curves);
-    st = HM_EDOMAIN;
-  }
-  return st;
+  if (st != HM_OK) return st;
+  const hm_field_check f[] = {{"table_n_conicity", (double)c->table_n_conicity, HM_RULE_RANGE, 2.0, 1000.0},
+                              {"table.tolerance_kmh", c->table.tolerance_kmh, HM_RULE_POSITIVE, 0.0, 0.0},
+                              {"table.tolerance_m", c->table.tolerance_m, HM_RULE_POSITIVE, 0.0, 0.0},
+                              {"table.refine", (double)c->table.refine, HM_RULE_FLAG, 0.0, 0.0},
+                              {"table.max_curves", (double)c->table.max_curves, HM_RULE_RANGE, 0.0, 10000.0}};
+  return hm_check_fields(f, HM_COUNT_OF(f), why, len);
 }
 
 static void chunk_clear(speed_chunk *k) {

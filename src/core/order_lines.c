@@ -9,6 +9,7 @@
 #include "fft.h"
 #include "select.h"
 #include "hunting_monitor/model.h"
+#include "validate.h"
 
 struct hm_order_lines_s {
   hm_order_lines_config cfg;
@@ -31,16 +32,10 @@ void hm_order_lines_config_default(hm_order_lines_config *c) {
 
 hm_status hm_order_lines_config_validate(const hm_order_lines_config *c, char *why, size_t len) {
   if (!c) return HM_EINVAL;
-  const char *field = NULL, *rule = NULL;
-  double got = 0.0;
-  if (!(c->min_ratio >= 3.0 && c->min_ratio <= 1e6))
-    field = "min_ratio", rule = "must be in 3..1e6", got = c->min_ratio;
-  else if (!(c->min_f >= 1.0 && c->min_f <= 1e6)) field = "min_f", rule = "must be in 1..1e6", got = c->min_f;
-  else if (!(c->dominance >= 1.0 && c->dominance <= 1e6))
-    field = "dominance", rule = "must be in 1..1e6", got = c->dominance;
-  if (!field) return HM_OK;
-  if (why && len) snprintf(why, len, "%s: %s (got %g)", field, rule, got);
-  return HM_EDOMAIN;
+  const hm_field_check f[] = {{"min_ratio", c->min_ratio, HM_RULE_RANGE, 3.0, 1e6},
+                              {"min_f", c->min_f, HM_RULE_RANGE, 1.0, 1e6},
+                              {"dominance", c->dominance, HM_RULE_RANGE, 1.0, 1e6}};
+  return hm_check_fields(f, HM_COUNT_OF(f), why, len);
 }
 
 void hm_order_lines_destroy(hm_order_lines o) {

@@ -5,6 +5,7 @@
 #include <stdarg.h>
 #include <stdio.h>
 #include <string.h>
+#include "validate.h"
 
 static const unsigned char magic[8] = {'H', 'M', 'S', 'T', 'A', 'T', 'E', '\0'};
 enum { HEADER_BYTES = 40, FIXED_BYTES = 136, WINDOW_BYTES = 72, MISFIT_BYTES = 8 };
@@ -15,9 +16,8 @@ void hm_state_config_default(hm_state_config *cfg) {
 
 hm_status hm_state_config_validate(const hm_state_config *cfg, char *why, size_t len) {
   if (!cfg) return HM_EINVAL;
-  if (cfg->period_s >= 0.1 && cfg->period_s <= 3600.0) return HM_OK;
-  if (why && len) snprintf(why, len, "state.period_s: must be in [0.1, 3600] (got %g)", cfg->period_s);
-  return HM_EDOMAIN;
+  const hm_field_check f[] = {{"state.period_s", cfg->period_s, HM_RULE_RANGE, 0.1, 3600.0}};
+  return hm_check_fields(f, HM_COUNT_OF(f), why, len);
 }
 
 /* ---- little-endian fields ---- */

@@ -6,6 +6,7 @@
 #include <math.h>
 #include <stdio.h>
 #include <string.h>
+#include "validate.h"
 
 void hm_track_lines_config_default(hm_track_lines_config *cfg) {
   if (!cfg) return;
@@ -17,21 +18,12 @@ void hm_track_lines_config_default(hm_track_lines_config *cfg) {
 hm_status hm_track_lines_config_validate(const hm_track_lines_config *cfg, char *why, size_t why_len) {
   if (!cfg) return HM_EINVAL;
   const double tol = cfg->wavelength_tol_rel;
-  const struct {
-    const char *name;
-    double v, lo, hi;
-    int lo_open;
-  } f[] = {{"wavelength_tol_rel", tol, 0.0, 0.05, 1},
-           {"min_speed_change_rel", cfg->min_speed_change_rel, 2.0 * (isfinite(tol) ? tol : 0.0), 0.5, 0},
-           {"memory_s", cfg->memory_s, 1.0, 1e6, 0}};
-  for (size_t i = 0; i < sizeof f / sizeof f[0]; ++i)
-    if (!((f[i].lo_open ? f[i].v > f[i].lo : f[i].v >= f[i].lo) && f[i].v <= f[i].hi)) {
-      if (why && why_len)
-        snprintf(why, why_len, "track_lines.%s: must be in %c%g, %g] (got %g)", f[i].name, f[i].lo_open ? '(' : '[',
-                 f[i].lo, f[i].hi, f[i].v);
-      return HM_EDOMAIN;
-    }
-  return HM_OK;
+  const hm_field_check f[] = {
+      {"track_lines.wavelength_tol_rel", tol, HM_RULE_RANGE_OPEN, 0.0, 0.05},
+      {"track_lines.min_speed_change_rel", cfg->min_speed_change_rel, HM_RULE_RANGE, 2.0 * (isfinite(tol) ? tol : 0.0),
+       0.5},
+      {"track_lines.memory_s", cfg->memory_s, HM_RULE_RANGE, 1.0, 1e6}};
+  return hm_check_fields(f, HM_COUNT_OF(f), why, why_len);
 }
 
 hm_status hm_track_lines_init(hm_track_lines *t, const hm_track_lines_config *cfg, char *why, size_t why_len) {

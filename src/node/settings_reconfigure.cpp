@@ -71,7 +71,7 @@ void SettingsReconfigure::onReconfigure(MonitorConfig& config, uint32_t) {
   char why[256] = "";
   hm_status st = HM_OK;
   if (config.peaks_count < 0) {  // not representable in the core's unsigned field: refused here, in its words
-    std::snprintf(why, sizeof why, "estimator.peaks_count: must be 1..1000 (got %d)", config.peaks_count);
+    std::snprintf(why, sizeof why, "estimator.peaks_count: must be in [1, 1000] (got %d)", config.peaks_count);
     st = HM_EDOMAIN;
   } else {
     want.estimator.peaks_count = static_cast<unsigned>(config.peaks_count);

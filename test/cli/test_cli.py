@@ -456,7 +456,7 @@ def test_estimate_bad_and_stale_input():
         with open(mon, "w") as f:
             f.write("estimator:\n  tracking_time_s: 57646075230342348\n")
         p = run("estimate", "--accel", acc, "--v", "400", "--table", tbl, "--monitor", mon, ok=False)
-        assert p.returncode == 1 and "tracking_time_s: must be at most 20" in p.stderr, p.stderr
+        assert p.returncode == 1 and "tracking_time_s: must be in (0, 20]" in p.stderr, p.stderr
         # inputs that used to run without a word
         def write(name, text):
             return write_file(d, name, text)
@@ -640,7 +640,9 @@ def test_estimate_streams_long_recordings():
         out = lines(p.stdout)
         peak_kb = int(p.stderr.strip().splitlines()[-1])
         close(out[-1]["t_s"], (n - 1) / 2000, 1e-9, "last line at the last sample")
-        assert peak_kb < 30_000, f"peak RSS {peak_kb} kB for a 51 MB recording"
+        # (40 MB: below the 48 MB that loading would take at the least; the AddressSanitizer build's shadow memory and
+        # quarantine of freed blocks add to the tool's own 15-20 MB: 31.9 MB seen under it)
+        assert peak_kb < 40_000, f"peak RSS {peak_kb} kB for a 51 MB recording"
 
 
 def test_equivalent_conicity_of_a_cone_with_unequal_radii():
@@ -685,7 +687,7 @@ def test_equivalent_conicity_of_a_cone_with_unequal_radii():
             (["--delta-r", write("ok.csv", "y_mm,delta_r_mm\n-1,-0.1\n0,0\n1,0.1\n"),
               "--amplitudes", "3:1:0.1"], "--amplitudes must be FROM:TO:STEP"),
             (["--delta-r", os.path.join(d, "ok.csv"), "--method", "fourier"], "--method must be integration or regression"),
-            (["--delta-r", os.path.join(d, "ok.csv"), "--r0-mm", "-460"], "r0_m: must be in (0, 5]"),
+            (["--delta-r", os.path.join(d, "ok.csv"), "--r0-mm", "-460"], "r0_m: must be in [0.1, 1]"),
         ]
         for args, message in cases:
             p = run("equivalent-conicity", *args, ok=False)

@@ -213,16 +213,16 @@ static void monitor_settings(void) {
       {"alarm:\n  use_conicity_estimate: maybe\n", "alarm.use_conicity_estimate: expected false or true", HM_EPARSE},
       {"estimator:\n  measurement_point: roof\n", "measurement_point: expected wheelset or bogie_frame", HM_EPARSE},
       {"estimator:\n  peaks_count: 6.5\n", "estimator.peaks_count: expected a whole number", HM_EPARSE},
-      {"estimator:\n  sample_rate_hz: 20\n", "estimator.sample_rate_hz: must be in 100..5000", HM_EDOMAIN},
-      {"alarm:\n  min_hold_s: -1\n", "alarm.min_hold_s: out of range", HM_EDOMAIN},
-      {"modal:\n  window_s: 1000\n", "modal.window_s: must be in 5..300", HM_EDOMAIN},
-      {"margin:\n  interval_z: 0\n", "margin.interval_z: must be in 0.5..10", HM_EDOMAIN},
+      {"estimator:\n  sample_rate_hz: 20\n", "estimator.sample_rate_hz: must be in [100, 5000]", HM_EDOMAIN},
+      {"alarm:\n  min_hold_s: -1\n", "alarm.min_hold_s: must be in [0, 3600] (got -1)", HM_EDOMAIN},
+      {"modal:\n  window_s: 1000\n", "modal.window_s: must be in [5, 300]", HM_EDOMAIN},
+      {"margin:\n  interval_z: 0\n", "margin.interval_z: must be in [0.5, 10]", HM_EDOMAIN},
       {"track_lines:\n  min_speed_change_rel: 0.01\n", "track_lines.min_speed_change_rel: must be in [0.02, 0.5]",
        HM_EDOMAIN},
       {"track_lines:\n  wavelength: 0.01\n", "track_lines.wavelength: unknown key", HM_EPARSE},
       /* found by fuzzing: huge values sized the buffers by an overflowing float-to-size_t conversion */
-      {"estimator:\n  tracking_time_s: 57646075230342348\n", "tracking_time_s: must be at most 20", HM_EDOMAIN},
-      {"estimator:\n  rms_window_m: 1e300\n", "rms_window_m: must be at most 1000", HM_EDOMAIN},
+      {"estimator:\n  tracking_time_s: 57646075230342348\n", "tracking_time_s: must be in (0, 20]", HM_EDOMAIN},
+      {"estimator:\n  rms_window_m: 1e300\n", "rms_window_m: must be in (0, 1000]", HM_EDOMAIN},
   };
   for (size_t i = 0; i < sizeof bad / sizeof bad[0]; ++i) {
     hm_monitor_config m2 = d;
