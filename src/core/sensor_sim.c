@@ -11,6 +11,7 @@
 #include "hunting_monitor/integrate.h"
 #include "hunting_monitor/linear.h"
 #include "rng.h"
+#include "validate.h"
 
 struct hm_sensor_sim_s {
   hm_sensor_sim_config cfg;
@@ -58,26 +59,27 @@ static hm_status refuse(char *why, size_t len, hm_status st, const char *fmt, ..
   return st;
 }
 
-static int rate_ok(double r) { return r > 0.0 && r <= 1e6; }
-
-/* The settings' checks, common to both kinds of run; n the state dimension of x0 (may be NULL). */
+/* The settings' checks (validate.h), common to both kinds of run; n the state dimension of x0 (may be NULL). */
 static hm_status check_config(const hm_sensor_sim_config *c, const double *x0, size_t n, char *why, size_t why_len) {
-  if (!(c->v_start_kmh > 0.0) || !(c->v_end_kmh > 0.0) || !isfinite(c->v_start_kmh) || !isfinite(c->v_end_kmh))
-    return refuse(why, why_len, HM_EDOMAIN, "speeds must be finite and > 0 km/h");
-  if (!(c->ramp_s >= 0.0) || !isfinite(c->ramp_s)) return refuse(why, why_len, HM_EDOMAIN, "ramp_s must be >= 0");
+  const hm_field_check f[] = {{"v_start_kmh", c->v_start_kmh, HM_RULE_POSITIVE, 0.0, 0.0},
+                              {"v_end_kmh", c->v_end_kmh, HM_RULE_POSITIVE, 0.0, 0.0},
+                              {"ramp_s", c->ramp_s, HM_RULE_NONNEG, 0.0, 0.0},
+                              {"irregularity_scale", c->irregularity_scale, HM_RULE_NONNEG, 0.0, 0.0},
+                              {"wavelength_min_m", c->wavelength_min_m, HM_RULE_RANGE, 0.2, 1000.0},
+                              {"wavelength_max_m", c->wavelength_max_m, HM_RULE_RANGE, 0.2, 1000.0},
+                              {"accel_rate_hz", c->accel_rate_hz, HM_RULE_RANGE_OPEN, 0.0, 1e6},
+                              {"speed_rate_hz", c->speed_rate_hz, HM_RULE_RANGE_OPEN, 0.0, 1e6},
+                              {"accel_noise_mps2", c->accel_noise_mps2, HM_RULE_NONNEG, 0.0, 0.0},
+                              {"rtol", c->rtol, HM_RULE_POSITIVE, 0.0, 0.0},
+                              {"atol", c->atol, HM_RULE_NONNEG, 0.0, 0.0},
+                              {"max_step_s", c->max_step_s, HM_RULE_NONNEG, 0.0, 0.0}};
+  const hm_status st = hm_check_fields(f, HM_COUNT_OF(f), why, why_len);
+  if (st != HM_OK) return st;
+  if (!(c->wavelength_max_m > c->wavelength_min_m))
+    return hm_reject(why, why_len, "wavelength_max_m", "must be above wavelength_min_m", c->wavelength_max_m);
   if (c->n_profile && !hm_speed_profile_valid(c->profile_t_s, c->profile_v_kmh, c->n_profile))
     return refuse(why, why_len, HM_EDOMAIN, "the speed profile needs at most %d points, speeds > 0 km/h at times "
                   "increasing from 0 s", HM_SPEED_PROFILE_MAX);
-  if (!(c->irregularity_scale >= 0.0) || !isfinite(c->irregularity_scale))
-    return refuse(why, why_len, HM_EDOMAIN, "irregularity scale must be >= 0");
-  if (!(c->wavelength_min_m >= 0.2) || !(c->wavelength_max_m > c->wavelength_min_m) || !(c->wavelength_max_m <= 1000.0))
-    return refuse(why, why_len, HM_EINVAL, "irregularity wavelengths must satisfy 0.2 <= min < max <= 1000 m");
-  if (!rate_ok(c->accel_rate_hz) || !rate_ok(c->speed_rate_hz))
-    return refuse(why, why_len, HM_EINVAL, "sample rates must be in (0, 1e6] Hz");
-  if (!(c->accel_noise_mps2 >= 0.0) || !isfinite(c->accel_noise_mps2))
-    return refuse(why, why_len, HM_EINVAL, "acceleration noise must be >= 0");
-  if (!(c->rtol > 0.0) || !(c->atol >= 0.0) || !(c->max_step_s >= 0.0) || !isfinite(c->max_step_s))
-    return refuse(why, why_len, HM_EINVAL, "need rtol > 0, atol >= 0, max_step_s >= 0");
   if (x0)
     for (size_t i = 0; i < n; ++i)
       if (!isfinite(x0[i])) return refuse(why, why_len, HM_EDOMAIN, "initial state not finite");

@@ -197,20 +197,20 @@ static void refused_settings(void) {
   char why[160];
   c = good;
   c.v_start_kmh = NAN;
-  HM_CHECK(hm_sensor_sim_create(&veh, &c, NULL, &s, why, sizeof why) == HM_EDOMAIN && strstr(why, "speed"), "NaN");
+  HM_CHECK(hm_sensor_sim_create(&veh, &c, NULL, &s, why, sizeof why) == HM_EDOMAIN && strstr(why, "v_start_kmh"), "NaN");
   c = good;
   c.accel_noise_mps2 = -0.1;
-  HM_CHECK(hm_sensor_sim_create(&veh, &c, NULL, &s, why, sizeof why) == HM_EINVAL && strstr(why, "noise"), "noise");
+  HM_CHECK(hm_sensor_sim_create(&veh, &c, NULL, &s, why, sizeof why) == HM_EDOMAIN && strstr(why, "noise"), "noise");
   c = good;
   c.speed_rate_hz = 0.0;
-  HM_CHECK(hm_sensor_sim_create(&veh, &c, NULL, &s, why, sizeof why) == HM_EINVAL && strstr(why, "rate"), "rate");
+  HM_CHECK(hm_sensor_sim_create(&veh, &c, NULL, &s, why, sizeof why) == HM_EDOMAIN && strstr(why, "rate"), "rate");
   c = good;
   c.wavelength_min_m = 200.0;
-  HM_CHECK(hm_sensor_sim_create(&veh, &c, NULL, &s, why, sizeof why) == HM_EINVAL && strstr(why, "wavelength"),
+  HM_CHECK(hm_sensor_sim_create(&veh, &c, NULL, &s, why, sizeof why) == HM_EDOMAIN && strstr(why, "wavelength"),
            "band");
   c = good;
   c.rtol = 0.0;
-  HM_CHECK(hm_sensor_sim_create(&veh, &c, NULL, &s, why, sizeof why) == HM_EINVAL && strstr(why, "rtol"), "rtol");
+  HM_CHECK(hm_sensor_sim_create(&veh, &c, NULL, &s, why, sizeof why) == HM_EDOMAIN && strstr(why, "rtol"), "rtol");
   hm_vehicle bad = veh;
   bad.mass_kg = -1.0;
   HM_CHECK(hm_sensor_sim_create(&bad, &good, NULL, &s, why, sizeof why) == HM_EDOMAIN && strstr(why, "mass_kg"),
