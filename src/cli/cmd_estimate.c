@@ -9,6 +9,7 @@
 #include "hunting_monitor/config.h"
 #include "hunting_monitor/linear.h"
 #include "hunting_monitor/monitor.h"
+#include "hunting_monitor/report.h"
 #include "hunting_monitor/state.h"
 #include "hunting_monitor/tables.h"
 #include "hunting_monitor/threads.h"
@@ -52,150 +53,30 @@ typedef struct {
   unsigned long speed_rows_unused;      /* speed rows after the acceleration's last sample: not given to the monitor */
 } read_counts;
 
-/* One JSON line; restored (the --state-in outcome) is written when not NULL. */
+/* One JSON line: the time, restored (the --state-in outcome) when not NULL, every field of the published status in
+ * report.h's order and gating, and what the tool read. */
 static void write_line(const hm_monitor_status *st, double t, const read_counts *rc, const char *restored) {
-  const hm_estimate *e = &st->estimate;
-  const hm_assessment *s = &st->assessment;
-  const hm_margin_estimate *g = &st->margin;
-  const hm_mode_estimate *md = &st->mode;
+  hm_report r;
+  hm_report_make(st, 0.0, &r);
   json_writer w;
   jw_init(&w, stdout);
   jw_object(&w, NULL);
   jw_number(&w, "t_s", t);
   if (restored) jw_string(&w, "restored", restored);
-  jw_string(&w, "level", hm_level_name(s->level));
-  jw_int(&w, "reason_code", (long)s->reason);
-  char reason[512];
-  hm_assessment_reason_text(s, 0.0, reason, sizeof reason); /* with a hold's cause, times and release condition */
-  jw_string(&w, "reason", reason);
-  jw_bool(&w, "level_changed", s->changed);
-  jw_bool(&w, "latched", s->latched);
-  jw_number(&w, "release_in_s", s->latched ? s->release_in_s : 0.0);
-  /* the hold in numbers (alarm.h) */
-  jw_bool(&w, "held", s->held);
-  jw_int(&w, "hold_cause_code", (long)s->hold_cause);
-  jw_string(&w, "hold_cause", s->latched ? hm_reason_text(s->hold_cause) : "");
-  jw_number(&w, "hold_since_s", s->hold_since_s);
-  jw_number(&w, "hold_last_met_s", s->hold_last_met_s);
-  jw_number(&w, "hold_release_below_kmh", s->hold_release_below_kmh);
-  jw_number(&w, "hold_release_amplitude_m", s->hold_release_amplitude_m);
-  jw_number(&w, "calm_s", s->calm_s);
-  jw_number(&w, "calm_needed_s", s->calm_needed_s);
-  jw_int(&w, "hold_waits", (long)s->hold_waits);
-  jw_bool(&w, "speed_valid", e->speed_valid);
-  jw_number(&w, "speed_kmh", e->speed_kmh);
-  jw_bool(&w, "accel_valid", e->accel_valid);
-  jw_number(&w, "sample_rate_hz", e->sample_rate_measured_hz);
-  jw_bool(&w, "sample_rate_mismatch", e->sample_rate_mismatch);
-  jw_bool(&w, "oscillation_valid", e->oscillation_valid);
-  jw_number(&w, "amplitude_accel_mps2", e->amplitude_accel_mps2);
-  jw_number(&w, "frequency_hz", e->frequency_hz);
-  jw_number(&w, "amplitude_m", e->amplitude_displacement_m);
-  /* the identified hunting mode (the latest window) */
-  jw_bool(&w, "mode_valid", st->mode_steady);
-  jw_bool(&w, "mode_fit_valid", md->valid);
-  jw_number(&w, "mode_frequency_hz", md->valid ? md->frequency_hz : NAN);
-  jw_number(&w, "mode_frequency_se_hz", md->valid ? md->frequency_se_hz : NAN);
-  jw_number(&w, "decay_rate_1_s", md->valid ? md->decay_rate_1_s : NAN);
-  jw_number(&w, "decay_rate_se_1_s", md->valid ? md->decay_rate_se_1_s : NAN);
-  jw_number(&w, "damping_ratio", md->valid ? md->damping_ratio : NAN);
-  jw_number(&w, "damping_ratio_se", md->valid ? md->damping_ratio_se : NAN);
-  jw_number(&w, "mode_speed_kmh", md->valid ? st->mode_speed_kmh : NAN);
-  jw_number(&w, "mode_speed_spread_kmh", md->valid && st->mode_speed_spread_kmh >= 0.0 ? st->mode_speed_spread_kmh : NAN);
-  jw_int(&w, "mode_pole_pairs", (long)(md->valid ? md->poles : 0));
-  jw_number(&w, "mode_second_frequency_hz", md->valid && md->poles == 2 ? md->second_frequency_hz : NAN);
-  jw_number(&w, "mode_second_decay_rate_1_s", md->valid && md->poles == 2 ? md->second_decay_rate_1_s : NAN);
-  jw_int(&w, "mode_window_verdict", (long)st->mode_verdict);
-  jw_string(&w, "mode_window_verdict_text", hm_window_verdict_text(st->mode_verdict));
-  /* a periodic excitation of the track found in the latest window (its bins left out of the fit) */
-  jw_bool(&w, "lines_found", md->lines_found);
-  jw_number(&w, "line_fundamental_hz", md->lines_found ? md->line_fundamental_hz : NAN);
-  jw_number(&w, "line_wavelength_m", md->lines_found ? st->line_wavelength_m : NAN);
-  jw_int(&w, "line_harmonics", (long)md->line_harmonics);
-  jw_number(&w, "line_strongest_hz", md->lines_found ? md->line_strongest_hz : NAN);
-  jw_number(&w, "line_strongest_mps2", md->lines_found ? md->line_strongest_mps2 : NAN);
-  /* lone lines set aside, and a narrow peak that may be a line or the mode (modal.h, margin.h) */
-  jw_int(&w, "lone_lines", (long)md->lone_lines);
-  jw_number(&w, "lone_line_hz", md->lone_lines ? md->lone_line_hz[0] : NAN);
-  jw_number(&w, "lone_line_mps2", md->lone_lines ? md->lone_line_mps2[0] : NAN);
-  jw_number(&w, "lone_line_wavelength_m",
-            md->lone_lines && md->lone_line_hz[0] > 0.0 ? hm_mps_from_kmh(st->mode_speed_kmh) / md->lone_line_hz[0] : NAN);
-  jw_int(&w, "order_lines", (long)md->order_lines);
-  jw_number(&w, "order_line_wavelength_m", md->order_lines ? md->order_line_wavelength_m : NAN);
-  jw_number(&w, "order_line_hz", md->order_lines ? md->order_line_hz : NAN);
-  jw_number(&w, "order_line_mps2", md->order_lines ? md->order_line_mps2 : NAN);
-  jw_number(&w, "mode_speed_tracking", md->speed_tracking);
-  jw_number(&w, "mode_speed_tracking_se", md->speed_tracking_se);
-  jw_bool(&w, "narrow_peak", md->narrow_peak);
-  jw_number(&w, "narrow_peak_hz", md->narrow_peak ? md->narrow_peak_hz : NAN);
-  jw_number(&w, "narrow_peak_wavelength_m",
-            md->narrow_peak && md->narrow_peak_wavelength_m > 0.0 ? md->narrow_peak_wavelength_m : NAN);
-  jw_bool(&w, "narrow_peak_tracked", md->narrow_peak_tracked);
-  jw_string(&w, "narrow_peak_taken_for", hm_narrow_verdict_text(g->narrow));
-  jw_int(&w, "windows_used", (long)g->n_windows);
-  /* the margin: model-based and model-free Hopf speeds */
-  jw_bool(&w, "conicity_valid", g->conicity_valid);
-  jw_number(&w, "conicity_estimate", g->conicity_valid ? g->conicity : NAN);
-  jw_number(&w, "conicity_se", g->conicity_valid ? g->conicity_se : NAN);
-  jw_number(&w, "hopf_model_kmh", g->hopf_model_valid ? g->hopf_model_kmh : NAN);
-  jw_number(&w, "hopf_model_kmh_low", g->hopf_model_valid ? g->hopf_model_low_kmh : NAN);
-  jw_number(&w, "hopf_model_kmh_high", g->hopf_model_valid ? g->hopf_model_high_kmh : NAN);
-  jw_bool(&w, "hopf_free_valid", g->hopf_free_valid);
-  jw_number(&w, "hopf_free_kmh", g->hopf_free_valid ? g->hopf_free_kmh : NAN);
-  jw_number(&w, "hopf_free_kmh_low", g->hopf_free_valid ? g->hopf_free_low_kmh : NAN);
-  jw_number(&w, "hopf_free_kmh_high", g->hopf_free_valid ? g->hopf_free_high_kmh : NAN);
-  /* as the level uses it (held against the provisional window's chatter, alarm.h), and as the windows say now */
-  jw_bool(&w, "model_mismatch", s->boundaries_valid ? s->model_mismatch : g->model_mismatch);
-  jw_bool(&w, "model_mismatch_windows", g->model_mismatch);
-  jw_number(&w, "birge_ratio", g->birge_ratio);
-  jw_int(&w, "misfit_windows", (long)g->n_misfits);
-  jw_int(&w, "conicity_changes", (long)g->n_changes);
-  jw_number(&w, "last_conicity_change_s", g->n_changes ? g->last_change_s : NAN);
-  jw_int(&w, "windows_since_change", (long)g->windows_since_change);
-  jw_int(&w, "conicity_outside_prior", (long)g->outside_prior);
-  const int b = s->boundaries_valid; /* no margins are shown as current without data */
-  jw_number(&w, "conicity_used", b ? s->conicity : NAN);
-  jw_bool(&w, "conicity_from_estimate", b && s->conicity_from_estimate);
-  jw_bool(&w, "conicity_from_prior", b && s->conicity_from_prior);
-  jw_bool(&w, "model_interval_used", b && s->model_interval_used);
-  jw_bool(&w, "hopf_free_used", b && s->hopf_free_used);
-  jw_number(&w, "hopf_kmh", b ? s->boundaries.hopf_speed_kmh : NAN);
-  jw_number(&w, "hopf_kmh_low", b ? s->hopf_low_kmh : NAN);
-  jw_number(&w, "hopf_kmh_high", b ? s->hopf_high_kmh : NAN);
-  jw_number(&w, "warn_from_kmh", b ? s->warn_from_kmh : NAN);
-  jw_number(&w, "watch_from_kmh", b ? s->watch_from_kmh : NAN);
-  jw_number(&w, "warn_risk", b ? s->warn_risk : NAN);
-  /* (a memory, not a margin: shown while it counts, also held without current data) */
-  jw_number(&w, "hunted_at_kmh", s->hunted_at_kmh);
-  jw_number(&w, "hunted_at_s", s->hunted_at_s);
-  jw_bool(&w, "hopf_low_from_hunting", b && s->hopf_low_from_hunting);
-  jw_number(&w, "anticipation_kmh", b ? s->anticipation_kmh : NAN);
-  jw_number(&w, "lowest_cycle_kmh", b ? s->boundaries.lowest_cycle_speed_kmh : NAN);
-  jw_int(&w, "conicity_outside_table", b ? (long)s->conicity_outside_table : 0L); /* boundaries widened (tables.h) */
-  jw_number(&w, "margin_hopf_kmh", b ? s->margin_hopf_kmh : NAN);
-  jw_number(&w, "margin_lowest_cycle_kmh", b ? s->margin_lowest_cycle_kmh : NAN);
-  jw_number(&w, "unstable_cycle_amplitude_m", b && s->edge_used_m > 0.0 ? s->edge_used_m : NAN);
-  jw_number(&w, "stable_cycle_amplitude_m",
-            b && s->boundaries.has_stable_outer ? s->boundaries.stable_outer_amp_m : NAN);
-  jw_number(&w, "rms_mps2", e->rms_mps2);
-  jw_bool(&w, "rms_exceeded", e->rms_exceeded);
-  jw_int(&w, "consecutive_peaks", (long)e->consecutive_peaks);
-  jw_bool(&w, "peaks_exceeded", e->peaks_exceeded);
-  jw_bool(&w, "displacement_exceeded", e->displacement_exceeded);
-  /* every input counter (estimator.h), the last line's at the end of the data */
+  size_t n = 0;
+  const hm_report_field *f = hm_report_fields(&n);
+  for (size_t i = 0; i < n; ++i) {
+    const char *at = (const char *)&r + f[i].offset;
+    switch (f[i].kind) {
+      case HM_REPORT_NUMBER: jw_number(&w, f[i].name, *(const double *)(const void *)at); break;
+      case HM_REPORT_INT: jw_int(&w, f[i].name, *(const long *)(const void *)at); break;
+      case HM_REPORT_FLAG: jw_bool(&w, f[i].name, *(const int *)(const void *)at); break;
+      case HM_REPORT_STATIC_TEXT: jw_string(&w, f[i].name, *(const char *const *)(const void *)at); break;
+      case HM_REPORT_TEXT: jw_string(&w, f[i].name, at); break;
+    }
+  }
   jw_int(&w, "accel_rows", (long)rc->accel_rows);
-  jw_int(&w, "accel_samples", (long)e->n_samples);
-  jw_int(&w, "rejected_samples", (long)(e->n_rejected_nonfinite + e->n_rejected_range + e->n_rejected_order));
-  jw_int(&w, "rejected_nonfinite", (long)e->n_rejected_nonfinite);
-  jw_int(&w, "rejected_out_of_range", (long)e->n_rejected_range);
-  jw_int(&w, "rejected_out_of_order", (long)e->n_rejected_order);
-  jw_int(&w, "gaps", (long)e->n_gaps);
-  jw_int(&w, "samples_lost", (long)e->n_samples_lost);
-  jw_number(&w, "samples_lost_fraction", e->loss_fraction);
-  jw_int(&w, "rate_changes", (long)e->n_rate_changes);
   jw_int(&w, "speed_rows", (long)rc->speed_rows);
-  jw_int(&w, "speed_updates", (long)e->n_speed_updates);
-  jw_int(&w, "rejected_speeds", (long)e->n_speed_rejected);
   jw_int(&w, "speed_rows_unused", (long)rc->speed_rows_unused);
   jw_end_object(&w);
   jw_finish(&w);

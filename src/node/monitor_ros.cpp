@@ -17,6 +17,7 @@
 extern "C" {
 #include "hunting_monitor/config.h"
 #include "hunting_monitor/linear.h"
+#include "hunting_monitor/report.h"
 #include "hunting_monitor/threads.h"
 }
 
@@ -379,8 +380,9 @@ void MonitorRos::onTimer(const ros::TimerEvent&) {
   have_last_ = true;
   const hm_estimate& e = st.estimate;
   const hm_assessment& s = st.assessment;
-  const hm_mode_estimate& md = st.mode;
   const hm_margin_estimate& g = st.margin;
+  hm_report r;  // every field gated once (report.h); NAN -> 0 beside its flag here
+  hm_report_make(&st, NAN, &r);  // times as ages: the sensor's line is no clock to read
 
   hunting_monitor::HuntingStatus m;
   m.header.stamp = now;
@@ -389,86 +391,84 @@ void MonitorRos::onTimer(const ros::TimerEvent&) {
   m.sensor_clock_offset_s = hm_clock_offset_s(&clock_);
   m.sensor_clock_steps = static_cast<uint32_t>(clock_.n_steps);
   m.level = static_cast<uint8_t>(s.level);
-  m.reason_code = static_cast<uint8_t>(s.reason);
-  m.reason = reasonText(s);
-  m.level_latched = s.latched;
-  m.latch_release_in_s = s.latched ? finite(s.release_in_s) : 0.0;
-  m.level_held = s.held;
-  m.hold_cause_code = static_cast<uint8_t>(s.hold_cause);
-  m.hold_cause = s.latched ? hm_reason_text(s.hold_cause) : "";
-  if (std::isfinite(s.hold_since_s)) m.hold_since = ros::Time(rosTime(s.hold_since_s));
-  if (std::isfinite(s.hold_last_met_s)) m.hold_last_met = ros::Time(rosTime(s.hold_last_met_s));
-  m.hold_release_below_kmh = finite(s.hold_release_below_kmh);
-  m.hold_release_amplitude_m = finite(s.hold_release_amplitude_m);
-  m.hold_calm_s = finite(s.calm_s);
-  m.hold_calm_needed_s = finite(s.calm_needed_s);
-  m.hold_waits = static_cast<uint8_t>(s.hold_waits);
-  m.hopf_low_from_hunting = s.boundaries_valid && s.hopf_low_from_hunting;
+  m.reason_code = static_cast<uint8_t>(r.reason_code);
+  m.reason = r.reason;
+  m.level_latched = r.latched;
+  m.latch_release_in_s = finite(r.release_in_s);
+  m.level_held = r.held;
+  m.hold_cause_code = static_cast<uint8_t>(r.hold_cause_code);
+  m.hold_cause = r.hold_cause;
+  if (std::isfinite(r.hold_since_s)) m.hold_since = ros::Time(rosTime(r.hold_since_s));
+  if (std::isfinite(r.hold_last_met_s)) m.hold_last_met = ros::Time(rosTime(r.hold_last_met_s));
+  m.hold_release_below_kmh = finite(r.hold_release_below_kmh);
+  m.hold_release_amplitude_m = finite(r.hold_release_amplitude_m);
+  m.hold_calm_s = finite(r.calm_s);
+  m.hold_calm_needed_s = finite(r.calm_needed_s);
+  m.hold_waits = static_cast<uint8_t>(r.hold_waits);
+  m.hopf_low_from_hunting = r.hopf_low_from_hunting;
   // (a memory, not a margin: shown while it counts, also held without current data)
-  m.hunted_at_kmh = std::isfinite(s.hunted_at_kmh) ? s.hunted_at_kmh : 0.0;
-  if (std::isfinite(s.hunted_at_s)) m.hunted_at = ros::Time(rosTime(s.hunted_at_s));
-  m.speed_kmh = finite(e.speed_kmh);
-  m.speed_valid = e.speed_valid;
-  m.sample_rate_hz = finite(e.sample_rate_measured_hz);
-  m.sample_rate_mismatch = e.sample_rate_mismatch;
-  m.samples_lost = e.n_samples_lost;
-  m.samples_lost_fraction = finite(e.loss_fraction);
-  m.mode_valid = st.mode_steady;  // a fit over a changing speed is not the mode's damping at a speed
-  m.mode_verdict = static_cast<uint8_t>(st.mode_verdict);
-  m.mode_verdict_text = hm_window_verdict_text(st.mode_verdict);
-  const bool mv = m.mode_valid;
-  m.mode_frequency_hz = mv ? finite(md.frequency_hz) : 0.0;
-  m.mode_frequency_se_hz = mv ? finite(md.frequency_se_hz) : 0.0;
-  m.decay_rate_1_s = mv ? finite(md.decay_rate_1_s) : 0.0;
-  m.decay_rate_se_1_s = mv ? finite(md.decay_rate_se_1_s) : 0.0;
-  m.damping_ratio = mv ? finite(md.damping_ratio) : 0.0;
-  m.damping_ratio_se = mv ? finite(md.damping_ratio_se) : 0.0;
-  m.windows_used = g.n_windows;
-  m.track_lines_found = md.lines_found;
-  m.track_line_wavelength_m = md.lines_found ? finite(st.line_wavelength_m) : 0.0;
-  m.track_line_spacing_hz = md.lines_found ? finite(md.line_fundamental_hz) : 0.0;
-  m.track_line_strongest_hz = md.lines_found ? finite(md.line_strongest_hz) : 0.0;
-  m.track_line_strongest_mps2 = md.lines_found ? finite(md.line_strongest_mps2) : 0.0;
-  m.mode_pole_pairs = static_cast<uint8_t>(md.valid ? md.poles : 0);
-  m.mode_second_frequency_hz = md.valid && md.poles == 2 ? finite(md.second_frequency_hz) : 0.0;
-  m.mode_second_decay_rate_1_s = md.valid && md.poles == 2 ? finite(md.second_decay_rate_1_s) : 0.0;
-  m.lone_lines = static_cast<uint8_t>(md.lone_lines);
-  m.lone_line_hz = md.lone_lines ? finite(md.lone_line_hz[0]) : 0.0;
-  m.lone_line_mps2 = md.lone_lines ? finite(md.lone_line_mps2[0]) : 0.0;
-  m.lone_line_wavelength_m =
-      md.lone_lines && md.lone_line_hz[0] > 0.0 ? finite(hm_mps_from_kmh(st.mode_speed_kmh) / md.lone_line_hz[0]) : 0.0;
-  m.order_lines = static_cast<uint8_t>(md.order_lines);
-  m.order_line_wavelength_m = md.order_lines ? finite(md.order_line_wavelength_m) : 0.0;
-  m.order_line_hz = md.order_lines ? finite(md.order_line_hz) : 0.0;
-  m.order_line_mps2 = md.order_lines ? finite(md.order_line_mps2) : 0.0;
-  m.narrow_peak = md.narrow_peak;
-  m.narrow_peak_hz = md.narrow_peak ? finite(md.narrow_peak_hz) : 0.0;
-  m.narrow_peak_verdict = static_cast<uint8_t>(g.narrow);
-  m.narrow_peak_verdict_text = hm_narrow_verdict_text(g.narrow);
-  m.narrow_peak_wavelength_m = md.narrow_peak ? finite(md.narrow_peak_wavelength_m) : 0.0;
-  m.narrow_peak_tracked = md.narrow_peak && md.narrow_peak_tracked;
-  m.speed_tracking_measured = std::isfinite(md.speed_tracking);
-  m.mode_speed_tracking = finite(md.speed_tracking);
-  m.mode_speed_tracking_se = finite(md.speed_tracking_se);
-  m.conicity_valid = g.conicity_valid;
-  m.conicity_estimate = g.conicity_valid ? finite(g.conicity) : 0.0;
-  m.conicity_se = g.conicity_valid ? finite(g.conicity_se) : 0.0;
-  m.hopf_model_valid = g.hopf_model_valid;
-  m.hopf_model_kmh = g.hopf_model_valid ? finite(g.hopf_model_kmh) : 0.0;
-  m.hopf_model_kmh_low = g.hopf_model_valid ? finite(g.hopf_model_low_kmh) : 0.0;
-  m.hopf_model_kmh_high = g.hopf_model_valid ? finite(g.hopf_model_high_kmh) : 0.0;
-  m.hopf_free_valid = g.hopf_free_valid;
-  m.hopf_free_kmh = g.hopf_free_valid ? finite(g.hopf_free_kmh) : 0.0;
-  m.hopf_free_kmh_low = g.hopf_free_valid ? finite(g.hopf_free_low_kmh) : 0.0;
-  m.hopf_free_kmh_high = g.hopf_free_valid ? finite(g.hopf_free_high_kmh) : 0.0;
-  m.model_mismatch = s.boundaries_valid ? s.model_mismatch : g.model_mismatch;  // as the level uses it (held)
-  m.model_mismatch_windows = g.model_mismatch;
-  m.windows_birge_ratio = finite(g.birge_ratio);
-  m.misfit_windows = g.n_misfits;
-  m.conicity_changes = static_cast<uint32_t>(g.n_changes);
-  m.windows_since_change = g.windows_since_change;
-  m.conicity_outside_prior = static_cast<int8_t>(g.outside_prior);
-  if (g.n_changes > 0) m.last_conicity_change = ros::Time(rosTime(g.last_change_s));
+  m.hunted_at_kmh = finite(r.hunted_at_kmh);
+  if (std::isfinite(r.hunted_at_s)) m.hunted_at = ros::Time(rosTime(r.hunted_at_s));
+  m.speed_kmh = finite(r.speed_kmh);
+  m.speed_valid = r.speed_valid;
+  m.sample_rate_hz = finite(r.sample_rate_hz);
+  m.sample_rate_mismatch = r.sample_rate_mismatch;
+  m.samples_lost = static_cast<uint64_t>(r.samples_lost);
+  m.samples_lost_fraction = finite(r.samples_lost_fraction);
+  m.mode_valid = r.mode_valid;  // a fit over a changing speed is shown, not used (mode_verdict says why)
+  m.mode_verdict = static_cast<uint8_t>(r.mode_window_verdict);
+  m.mode_verdict_text = r.mode_window_verdict_text;
+  m.mode_frequency_hz = finite(r.mode_frequency_hz);
+  m.mode_frequency_se_hz = finite(r.mode_frequency_se_hz);
+  m.decay_rate_1_s = finite(r.decay_rate_1_s);
+  m.decay_rate_se_1_s = finite(r.decay_rate_se_1_s);
+  m.damping_ratio = finite(r.damping_ratio);
+  m.damping_ratio_se = finite(r.damping_ratio_se);
+  m.windows_used = static_cast<uint32_t>(r.windows_used);
+  m.track_lines_found = r.lines_found;
+  m.track_line_wavelength_m = finite(r.line_wavelength_m);
+  m.track_line_spacing_hz = finite(r.line_fundamental_hz);
+  m.track_line_strongest_hz = finite(r.line_strongest_hz);
+  m.track_line_strongest_mps2 = finite(r.line_strongest_mps2);
+  m.mode_pole_pairs = static_cast<uint8_t>(r.mode_pole_pairs);
+  m.mode_second_frequency_hz = finite(r.mode_second_frequency_hz);
+  m.mode_second_decay_rate_1_s = finite(r.mode_second_decay_rate_1_s);
+  m.lone_lines = static_cast<uint8_t>(r.lone_lines);
+  m.lone_line_hz = finite(r.lone_line_hz);
+  m.lone_line_mps2 = finite(r.lone_line_mps2);
+  m.lone_line_wavelength_m = finite(r.lone_line_wavelength_m);
+  m.order_lines = static_cast<uint8_t>(r.order_lines);
+  m.order_line_wavelength_m = finite(r.order_line_wavelength_m);
+  m.order_line_hz = finite(r.order_line_hz);
+  m.order_line_mps2 = finite(r.order_line_mps2);
+  m.narrow_peak = r.narrow_peak;
+  m.narrow_peak_hz = finite(r.narrow_peak_hz);
+  m.narrow_peak_verdict = static_cast<uint8_t>(r.narrow_peak_verdict);
+  m.narrow_peak_verdict_text = r.narrow_peak_taken_for;
+  m.narrow_peak_wavelength_m = finite(r.narrow_peak_wavelength_m);
+  m.narrow_peak_tracked = r.narrow_peak_tracked;
+  m.speed_tracking_measured = std::isfinite(r.mode_speed_tracking);
+  m.mode_speed_tracking = finite(r.mode_speed_tracking);
+  m.mode_speed_tracking_se = finite(r.mode_speed_tracking_se);
+  m.conicity_valid = r.conicity_valid;
+  m.conicity_estimate = finite(r.conicity_estimate);
+  m.conicity_se = finite(r.conicity_se);
+  m.hopf_model_valid = r.hopf_model_valid;
+  m.hopf_model_kmh = finite(r.hopf_model_kmh);
+  m.hopf_model_kmh_low = finite(r.hopf_model_kmh_low);
+  m.hopf_model_kmh_high = finite(r.hopf_model_kmh_high);
+  m.hopf_free_valid = r.hopf_free_valid;
+  m.hopf_free_kmh = finite(r.hopf_free_kmh);
+  m.hopf_free_kmh_low = finite(r.hopf_free_kmh_low);
+  m.hopf_free_kmh_high = finite(r.hopf_free_kmh_high);
+  m.model_mismatch = r.model_mismatch;  // as the level uses it (held)
+  m.model_mismatch_windows = r.model_mismatch_windows;
+  m.windows_birge_ratio = finite(r.birge_ratio);
+  m.misfit_windows = static_cast<uint32_t>(r.misfit_windows);
+  m.conicity_changes = static_cast<uint32_t>(r.conicity_changes);
+  m.windows_since_change = static_cast<uint32_t>(r.windows_since_change);
+  m.conicity_outside_prior = static_cast<int8_t>(r.conicity_outside_prior);
+  if (std::isfinite(r.last_conicity_change_s)) m.last_conicity_change = ros::Time(rosTime(r.last_conicity_change_s));
   if (g.n_changes != last_changes_) {
     if (g.n_changes > last_changes_)
       ROS_WARN("hunting_monitor: the conicity changed (a window %.0f s ago disagreed with those held): the "
@@ -476,24 +476,23 @@ void MonitorRos::onTimer(const ros::TimerEvent&) {
                lineTime(now) - g.last_change_s);
     last_changes_ = g.n_changes;
   }
-  m.boundaries_valid = s.boundaries_valid;  // never a stale margin presented as current
-  const hm_table_lookup_result& b = s.boundaries;
-  m.conicity_used = s.boundaries_valid ? finite(s.conicity) : 0.0;
-  m.conicity_from_estimate = s.boundaries_valid && s.conicity_from_estimate;
-  m.conicity_from_prior = s.boundaries_valid && s.conicity_from_prior;
-  m.model_interval_used = s.boundaries_valid && s.model_interval_used;
-  m.hopf_free_used = s.boundaries_valid && s.hopf_free_used;
-  m.conicity_outside_table = static_cast<int8_t>(s.boundaries_valid ? s.conicity_outside_table : 0);
-  m.hopf_speed_kmh = s.boundaries_valid ? finite(b.hopf_speed_kmh) : 0.0;
-  m.hopf_speed_kmh_low = s.boundaries_valid ? finite(s.hopf_low_kmh) : 0.0;
-  m.hopf_speed_kmh_high = s.boundaries_valid ? finite(s.hopf_high_kmh) : 0.0;
-  m.warn_from_kmh = s.boundaries_valid ? finite(s.warn_from_kmh) : 0.0;
-  m.watch_from_kmh = s.boundaries_valid ? finite(s.watch_from_kmh) : 0.0;
-  m.warn_risk = s.boundaries_valid ? finite(s.warn_risk) : 0.0;
-  m.anticipation_kmh = s.boundaries_valid ? finite(s.anticipation_kmh) : 0.0;
-  m.lowest_cycle_speed_kmh = s.boundaries_valid ? finite(b.lowest_cycle_speed_kmh) : 0.0;
-  m.margin_to_hopf_kmh = s.boundaries_valid ? finite(s.margin_hopf_kmh) : 0.0;
-  m.margin_to_lowest_cycle_kmh = s.boundaries_valid ? finite(s.margin_lowest_cycle_kmh) : 0.0;
+  m.boundaries_valid = r.boundaries_valid;  // never a stale margin presented as current
+  m.conicity_used = finite(r.conicity_used);
+  m.conicity_from_estimate = r.conicity_from_estimate;
+  m.conicity_from_prior = r.conicity_from_prior;
+  m.model_interval_used = r.model_interval_used;
+  m.hopf_free_used = r.hopf_free_used;
+  m.conicity_outside_table = static_cast<int8_t>(r.conicity_outside_table);
+  m.hopf_speed_kmh = finite(r.hopf_kmh);
+  m.hopf_speed_kmh_low = finite(r.hopf_kmh_low);
+  m.hopf_speed_kmh_high = finite(r.hopf_kmh_high);
+  m.warn_from_kmh = finite(r.warn_from_kmh);
+  m.watch_from_kmh = finite(r.watch_from_kmh);
+  m.warn_risk = finite(r.warn_risk);
+  m.anticipation_kmh = finite(r.anticipation_kmh);
+  m.lowest_cycle_speed_kmh = finite(r.lowest_cycle_kmh);
+  m.margin_to_hopf_kmh = finite(r.margin_hopf_kmh);
+  m.margin_to_lowest_cycle_kmh = finite(r.margin_lowest_cycle_kmh);
   m.table_conicities = static_cast<uint32_t>(hm_table_size(hm_monitor_table(monitor_), nullptr, nullptr));
   double err_kmh = 0.0, err_m = 0.0;
   if (s.boundaries_valid && hm_table_local_error(hm_monitor_table(monitor_), s.conicity, &err_kmh, &err_m) == HM_OK) {
@@ -501,18 +500,18 @@ void MonitorRos::onTimer(const ros::TimerEvent&) {
     m.table_error_amp_m = finite(err_m);
   }
   m.table_refining = refiner_->busy();
-  m.amplitude_accel_mps2 = finite(e.amplitude_accel_mps2);
-  m.amplitude_displacement_m = finite(e.amplitude_displacement_m);
-  m.frequency_hz = finite(e.frequency_hz);
-  m.oscillation_valid = e.oscillation_valid;
-  m.cycles_valid = s.boundaries_valid && s.edge_used_m > 0.0;
-  m.unstable_cycle_amplitude_m = m.cycles_valid ? finite(s.edge_used_m) : 0.0;
-  m.stable_cycle_amplitude_m = s.boundaries_valid && b.has_stable_outer ? finite(b.stable_outer_amp_m) : 0.0;
-  m.rms_accel_mps2 = finite(e.rms_mps2);
-  m.consecutive_peaks = e.consecutive_peaks;
-  m.criterion_rms_exceeded = e.rms_exceeded;
-  m.criterion_peaks_exceeded = e.peaks_exceeded;
-  m.criterion_displacement_exceeded = e.displacement_exceeded;
+  m.amplitude_accel_mps2 = finite(r.amplitude_accel_mps2);
+  m.amplitude_displacement_m = finite(r.amplitude_m);
+  m.frequency_hz = finite(r.frequency_hz);
+  m.oscillation_valid = r.oscillation_valid;
+  m.cycles_valid = r.cycles_valid;
+  m.unstable_cycle_amplitude_m = finite(r.unstable_cycle_amplitude_m);
+  m.stable_cycle_amplitude_m = finite(r.stable_cycle_amplitude_m);
+  m.rms_accel_mps2 = finite(r.rms_mps2);
+  m.consecutive_peaks = static_cast<uint32_t>(r.consecutive_peaks);
+  m.criterion_rms_exceeded = r.rms_exceeded;
+  m.criterion_peaks_exceeded = r.peaks_exceeded;
+  m.criterion_displacement_exceeded = r.displacement_exceeded;
   status_pub_.publish(m);
 
   publishLevel(s, m.reason, now);
