@@ -507,17 +507,25 @@ static double warn_below_point(double point_kmh, double low_kmh, double margin_k
   return point_kmh - fmax(margin_kmh, fmin((point_kmh - low_kmh) / z, HM_ALARM_WARN_MAX_BELOW_KMH));
 }
 
-/* The conicity in use, the Hopf interval and the boundaries at the current speed; the table's status on failure. */
-static hm_status assess(hm_alarm a, const hm_estimate *e, const hm_margin_estimate *g, hm_assessment *s) {
+/* What the evidence allows this update (alarm.h): which estimates count, each flag held against its chatter. */
+typedef struct {
+  int mismatch;      /* model_mismatch as the level uses it (sticky) */
+  int precise;       /* the estimate enters alone */
+  int usable;        /* the estimate counts, combined with the prior where not precise */
+  int free_alone;    /* the model-free interval is the only evidence of where the Hopf speed lies */
+  int free_counts;   /* the model-free interval's lower end counts (its last valid one, held) */
+} evidence;
+
+static evidence weigh_evidence(hm_alarm a, const hm_margin_estimate *g, double now) {
   const hm_alarm_config *c = &a->cfg;
-  const double now = s->time_s;
+  evidence ev;
   /* a bogie's or car's model holds the frame: a frame sensor shows one of its modes (issue #28) */
   const int axle = a->point == HM_POINT_WHEELSET || (a->model && hm_mode_model_kind(a->model) != HM_MODEL_WHEELSET);
   const int have = c->use_conicity_estimate && g && g->conicity_valid && g->hopf_model_valid;
   /* the margin's flags as the level uses them, held against the provisional window's chatter (alarm.h) */
-  const int mismatch = sticky(&a->mismatch, g && g->model_mismatch, now);
+  ev.mismatch = sticky(&a->mismatch, g && g->model_mismatch, now);
   /* the model-based interval counts from an axle-box sensor on a vehicle that behaves like its model (alarm.h) */
-  const int usable_model = have && axle && !mismatch;
+  const int usable_model = have && axle && !ev.mismatch;
   /* the standard error within conicity_max_se, once so within HM_ALARM_SE_HYSTERESIS times it (its own hysteresis,
    * whatever else keeps the estimate from being used alone) */
   const double max_se = a->se_ok ? HM_ALARM_SE_HYSTERESIS * c->conicity_max_se : c->conicity_max_se;
@@ -528,80 +536,102 @@ static hm_status assess(hm_alarm a, const hm_estimate *e, const hm_margin_estima
    * combined with the prior (the more cautious): one precise but above the prior's range (its Hopf speed lower: worn
    * beyond the prior), or any with a lightly damped mode held (alarm.h) */
   const int alone = a->se_ok && !g->outside_prior && !unconfirmed_change;
-  const int precise = regained(a, alone, now);
+  ev.precise = regained(a, alone, now);
   const int cautious_precise = a->se_ok && g->outside_prior > 0;
   /* a change's first window, precise, is the evidence of the change (margin.h): combined with the prior (the more
    * cautious) whatever its distance from the Hopf speed (issue #27: 0.12 -> 0.18 +- 0.008 at 300 km/h had left the
    * prior alone, WATCH at 450 km/h above the new Hopf speed of 444.9) */
   const int change_evidence = a->se_ok && unconfirmed_change;
-  const int usable = precise || alone || cautious_precise || change_evidence || (usable_model && g->near_evidence);
-  /* the prior's interval, and the uncertain estimate's where it is the more cautious */
-  double lambda = c->conicity_fallback, lambda_opt = c->conicity_prior_low;
-  double lo = a->prior_hopf_low_kmh, hi = a->prior_hopf_high_kmh;
-  s->conicity_from_estimate = precise;
-  s->conicity_from_prior = !precise;
-  s->model_interval_used = usable;
-  s->conicity_se = 0.0;
-  if (precise) {
-    lambda = g->conicity;
-    lambda_opt = g->conicity_low;
-    lo = g->hopf_model_low_kmh;
-    hi = g->hopf_model_high_kmh;
-    s->conicity_se = g->conicity_se;
-  } else if (usable) {
-    if (g->hopf_model_kmh < hopf_kmh(&a->veh, a->model, lambda)) lambda = g->conicity, s->conicity_se = g->conicity_se;
-    lo = fmin(lo, g->hopf_model_low_kmh);
-    if (g->hopf_model_high_kmh < hi) hi = g->hopf_model_high_kmh, lambda_opt = g->conicity_low;
-    /* the prior sets the interval only where the estimate moved neither end */
-    s->conicity_from_prior = lo == a->prior_hopf_low_kmh && hi == a->prior_hopf_high_kmh;
-  }
+  ev.usable = ev.precise || alone || cautious_precise || change_evidence || (usable_model && g->near_evidence);
   /* the model-free interval's lower end counts when the model-based one does not (a mismatch, a sensor off the axle
    * box; then its upper end too: it is the only evidence of where the vehicle's Hopf speed lies, and on a bogie 40-60
    * km/h less stable than the model it gave WARN a median 20 s before 3 mm, 5 s without), and beside it when its
    * regression has residuals to check it (three windows or more) and a lightly damped mode is held: a zero crossing
    * extrapolated from decay rates of -5..-11 1/s alone is wide (on a ramp from 271 to 301 km/h, 322 [309, ...] for a
    * Hopf speed of 357) and its lower end is no evidence */
-  const int free_alone = g && (mismatch || !axle);
+  ev.free_alone = g && (ev.mismatch || !axle);
   const int free_valid = g && g->hopf_free_valid;
   if (free_valid) a->free_low_kmh = g->hopf_free_low_kmh, a->free_high_kmh = g->hopf_free_high_kmh;
-  const int free_beside = sticky(
-      &a->free_beside, free_valid && g->n_windows >= HM_ALARM_FREE_MIN_WINDOWS && g->near_evidence && !free_alone, now);
-  const int free_counts = (free_valid && free_alone) || free_beside; /* (held: its last valid interval) */
-  s->model_mismatch = mismatch;
-  s->hopf_free_used = free_counts;
-  if (free_counts) {
-    lo = fmin(lo, a->free_low_kmh);
-    if (free_alone && a->free_high_kmh < hi) hi = a->free_high_kmh;
+  const int free_beside = sticky(&a->free_beside,
+                                 free_valid && g->n_windows >= HM_ALARM_FREE_MIN_WINDOWS && g->near_evidence &&
+                                     !ev.free_alone,
+                                 now);
+  ev.free_counts = (free_valid && ev.free_alone) || free_beside; /* (held: its last valid interval) */
+  return ev;
+}
+
+/* The Hopf interval [lo, hi] the evidence gives, from the prior's, and the conicity in use with its optimistic end
+ * (the interval's upper end's); s's provenance flags. */
+static void evidence_interval(const hm_alarm a, const hm_margin_estimate *g, const evidence *ev, double *lambda,
+                              double *lambda_opt, double *lo, double *hi, hm_assessment *s) {
+  const hm_alarm_config *c = &a->cfg;
+  *lambda = c->conicity_fallback, *lambda_opt = c->conicity_prior_low;
+  *lo = a->prior_hopf_low_kmh, *hi = a->prior_hopf_high_kmh;
+  s->conicity_from_estimate = ev->precise;
+  s->conicity_from_prior = !ev->precise;
+  s->model_interval_used = ev->usable;
+  s->conicity_se = 0.0;
+  if (ev->precise) {
+    *lambda = g->conicity;
+    *lambda_opt = g->conicity_low;
+    *lo = g->hopf_model_low_kmh;
+    *hi = g->hopf_model_high_kmh;
+    s->conicity_se = g->conicity_se;
+  } else if (ev->usable) {
+    if (g->hopf_model_kmh < hopf_kmh(&a->veh, a->model, *lambda)) *lambda = g->conicity, s->conicity_se = g->conicity_se;
+    *lo = fmin(*lo, g->hopf_model_low_kmh);
+    if (g->hopf_model_high_kmh < *hi) *hi = g->hopf_model_high_kmh, *lambda_opt = g->conicity_low;
+    /* the prior sets the interval only where the estimate moved neither end */
+    s->conicity_from_prior = *lo == a->prior_hopf_low_kmh && *hi == a->prior_hopf_high_kmh;
   }
+  s->model_mismatch = ev->mismatch;
+  s->hopf_free_used = ev->free_counts;
+  if (ev->free_counts) {
+    *lo = fmin(*lo, a->free_low_kmh);
+    if (ev->free_alone && a->free_high_kmh < *hi) *hi = a->free_high_kmh;
+  }
+}
+
+/* The speed margins (alarm.h): added to a range's lower end; below an identified interval WATCH in quadrature with
+ * its lower half-width h, WARN from the point less the larger of the margin and one standard error (h / z); an
+ * estimate too uncertain to be used alone (the vehicle behaving like its model) gives its own WARN threshold so, and
+ * the more cautious of it and the prior's range counts. warn_risk: what the WARN rule risks (the interval read as
+ * normal, its lower half-width interval_z standard errors). */
+static void speed_thresholds(const hm_alarm a, const hm_margin_estimate *g, const evidence *ev, hm_assessment *s) {
+  const hm_alarm_config *c = &a->cfg;
+  const hm_table_lookup_result *b = &s->boundaries;
+  const double h = ev->precise ? b->hopf_speed_kmh - s->hopf_low_kmh : 0.0;
+  const double from = ev->precise ? b->hopf_speed_kmh : s->hopf_low_kmh;
+  const double z = g && g->interval_z > 0.0 ? g->interval_z : 1.0;
+  s->warn_from_kmh = warn_below_point(from, ev->precise ? s->hopf_low_kmh : from, c->warn_speed_margin_kmh, z);
+  if (ev->usable && !ev->precise) {
+    const double lo_e = ev->free_counts ? fmin(g->hopf_model_low_kmh, a->free_low_kmh) : g->hopf_model_low_kmh;
+    s->warn_from_kmh = fmin(a->prior_hopf_low_kmh - c->warn_speed_margin_kmh,
+                            warn_below_point(g->hopf_model_kmh, lo_e, c->warn_speed_margin_kmh, z));
+  }
+  s->watch_from_kmh = from - hypot(h, c->watch_speed_margin_kmh);
+  s->warn_risk = ev->precise && h > 0.0 ? 0.5 * erfc((from - s->warn_from_kmh) / (h / z) / sqrt(2.0)) : NAN;
+  /* (the cap makes it larger than one standard error's 0.159 where the error exceeds the cap) */
+}
+
+/* The conicity in use, the Hopf interval and the boundaries at the current speed; the table's status on failure. */
+static hm_status assess(hm_alarm a, const hm_estimate *e, const hm_margin_estimate *g, hm_assessment *s) {
+  const evidence ev = weigh_evidence(a, g, s->time_s);
+  double lambda, lambda_opt, lo, hi;
+  evidence_interval(a, g, &ev, &lambda, &lambda_opt, &lo, &hi, s);
   s->conicity = lambda;
   hm_table_lookup_result b, bo;
   hm_status st = lookup(a, 0, lambda, e->speed_kmh, &b);
   if (st != HM_OK) return st;
   s->conicity_outside_table = b.conicity == lambda ? 0 : lambda > b.conicity ? 1 : -1;
-  if (!precise) { /* the table's value at the point is inside the interval it is shown with */
+  if (!ev.precise) { /* the table's value at the point is inside the interval it is shown with */
     lo = fmin(lo, b.hopf_speed_kmh - b.error_speed_kmh);
     hi = fmax(hi, b.hopf_speed_kmh + b.error_speed_kmh);
   }
   s->hopf_low_kmh = fmin(lo, b.hopf_speed_kmh);
   s->hopf_high_kmh = fmax(hi, b.hopf_speed_kmh);
   s->boundaries = b;
-  /* the speed margins (alarm.h): added to a range's lower end; below an identified interval WATCH in quadrature with
-   * its lower half-width h, WARN from the point less the larger of the margin and one standard error (h / z); an
-   * estimate too uncertain to be used alone (the vehicle behaving like its model) gives its own WARN threshold so,
-   * and the more cautious of it and the prior's range counts */
-  const double h = precise ? b.hopf_speed_kmh - s->hopf_low_kmh : 0.0;
-  const double from = precise ? b.hopf_speed_kmh : s->hopf_low_kmh;
-  const double z = g && g->interval_z > 0.0 ? g->interval_z : 1.0;
-  s->warn_from_kmh = warn_below_point(from, precise ? s->hopf_low_kmh : from, c->warn_speed_margin_kmh, z);
-  if (usable && !precise) {
-    const double lo_e = free_counts ? fmin(g->hopf_model_low_kmh, a->free_low_kmh) : g->hopf_model_low_kmh;
-    s->warn_from_kmh = fmin(a->prior_hopf_low_kmh - c->warn_speed_margin_kmh,
-                            warn_below_point(g->hopf_model_kmh, lo_e, c->warn_speed_margin_kmh, z));
-  }
-  s->watch_from_kmh = from - hypot(h, c->watch_speed_margin_kmh);
-  /* what the WARN rule risks (alarm.h): the interval read as normal, its lower half-width interval_z standard errors */
-  s->warn_risk = precise && h > 0.0 ? 0.5 * erfc((from - s->warn_from_kmh) / (h / z) / sqrt(2.0)) : NAN;
-  /* (the cap makes it larger than one standard error's 0.159 where the error exceeds the cap) */
+  speed_thresholds(a, g, &ev, s);
   /* the edge: at the conicity in use where the origin is stable there; inside the Hopf interval above the point
    * estimate, at the interval's optimistic end (found by the lookup at the conicity whose Hopf speed is hopf_high,
    * which the table's affine 1/V^2 makes exact) */
@@ -611,7 +641,7 @@ static hm_status assess(hm_alarm a, const hm_estimate *e, const hm_margin_estima
     if (st != HM_OK) return st;
     s->edge_used_m = bo.origin_stable && bo.has_edge ? bo.edge_amp_m : 0.0;
   }
-  a->precise = precise;
+  a->precise = ev.precise;
   return HM_OK;
 }
 
@@ -699,91 +729,115 @@ static void hold_numbers(const hm_alarm a, double now, hm_assessment *s) {
   }
 }
 
-hm_status hm_alarm_update(hm_alarm a, const hm_estimate *e, const hm_margin_estimate *g, double now, hm_assessment *out) {
-  if (!a || !e || !out || !isfinite(now)) return HM_EINVAL;
-  const hm_alarm_config *c = &a->cfg;
-  hm_assessment s;
-  memset(&s, 0, sizeof s);
-  s.time_s = now;
-  s.speed_kmh = e->speed_valid ? e->speed_kmh : 0.0;
-  s.hunted_at_kmh = s.hunted_at_s = NAN;
-  hm_reason reason;
-  hm_level target;
-  int released = 0, kept = 0;
-  if (!e->accel_valid || !e->speed_valid) {
-    target = HM_LEVEL_NO_DATA;
-    reason = !e->sample_rate_supported ? HM_REASON_BAD_SAMPLE_RATE
-             : !e->accel_valid         ? HM_REASON_NO_ACCEL
-                                       : HM_REASON_NO_SPEED;
-    a->block_n = a->n_blocks = 0; /* no speed: the acceleration starts again */
-    if (a->latched) { /* a held ALARM outlives its data: nothing says the oscillation has gone (alarm.h) */
-      s.hold_no_data = reason;
-      target = HM_LEVEL_ALARM;
-      reason = a->latch_cause;
-      a->calm = 0;
-      s.latched = s.held = 1;
-      s.hold_release_below_kmh = s.hold_release_amplitude_m = NAN; /* no current boundaries */
-      s.hold_waits = HM_HOLD_WAITS_DATA;
-      if (a->hunted_at_kmh < INFINITY) /* (it counts while held) */
-        s.hunted_at_kmh = a->hunted_at_kmh, s.hunted_at_s = a->hunted_t_s;
-    }
-  } else {
-    const hm_status st = assess(a, e, g, &s);
-    if (st != HM_OK) return st;
-    s.boundaries_valid = 1;
-    s.narrow_peak_ambiguous = g && g->ambiguous_at_s > 0.0 && now - g->ambiguous_at_s <= HM_ALARM_NARROW_HOLD_S;
-    s.margin_hopf_kmh = s.boundaries.hopf_speed_kmh - e->speed_kmh;
-    s.margin_lowest_cycle_kmh = s.boundaries.lowest_cycle_speed_kmh - e->speed_kmh;
-    s.amplitude_m = e->oscillation_valid ? e->amplitude_displacement_m : 0.0;
-    s.amplitude_margin_m = s.edge_used_m > 0.0 ? s.edge_used_m - s.amplitude_m : 0.0;
-    hunted_bound(a, e, now, &s);
-    /* the speed's trend (accelerating toward a threshold makes a lower level short-lived) */
-    if (a->have_trend && now > a->t_prev_s) {
-      const double dt = now - a->t_prev_s, w = fmin(dt / HM_ALARM_TREND_S, 1.0);
-      a->dvdt_kmh_s += w * ((e->speed_kmh - a->v_prev_kmh) / dt - a->dvdt_kmh_s);
-    }
-    a->have_trend = 1;
-    a->v_prev_kmh = e->speed_kmh;
-    a->t_prev_s = now;
-    /* (an identified interval only: the prior's range is already the cautious end of the wheels' wear) */
-    const double accel_kmh_s = sustained_acceleration(a, now, e->speed_kmh);
-    s.anticipation_kmh = s.conicity_from_estimate ? accel_kmh_s * HM_ALARM_RAISE_LOOKAHEAD_S : 0.0;
-    target = raw_level(a, e, g, &s, a->level, &reason);
-    if (target < a->level && a->dvdt_kmh_s > 0.0) {
-      /* a lower level only if it would still hold at the speed the present acceleration reaches in
-       * HM_ALARM_LOWER_LOOKAHEAD_S: a train accelerating past a threshold just lowered would raise the level again */
-      hm_estimate ahead = *e;
-      ahead.speed_kmh += a->dvdt_kmh_s * HM_ALARM_LOWER_LOOKAHEAD_S;
-      hm_reason r_ahead;
-      if (raw_level(a, &ahead, g, &s, a->level, &r_ahead) >= a->level) target = a->level, reason = a->reason, kept = 1;
-    }
-    released = latch(a, e, now, &s, &target, &reason, kept);
+/* Without current data: NO_DATA for the missing input, or a latched ALARM held through it (alarm.h); the level
+ * wanted, its reason in *reason. */
+static hm_level target_without_data(hm_alarm a, const hm_estimate *e, hm_assessment *s, hm_reason *reason) {
+  *reason = !e->sample_rate_supported ? HM_REASON_BAD_SAMPLE_RATE
+            : !e->accel_valid         ? HM_REASON_NO_ACCEL
+                                      : HM_REASON_NO_SPEED;
+  a->block_n = a->n_blocks = 0; /* no speed: the acceleration starts again */
+  if (!a->latched) return HM_LEVEL_NO_DATA;
+  /* a held ALARM outlives its data: nothing says the oscillation has gone (alarm.h) */
+  s->hold_no_data = *reason;
+  *reason = a->latch_cause;
+  a->calm = 0;
+  s->latched = s->held = 1;
+  s->hold_release_below_kmh = s->hold_release_amplitude_m = NAN; /* no current boundaries */
+  s->hold_waits = HM_HOLD_WAITS_DATA;
+  if (a->hunted_at_kmh < INFINITY) /* (it counts while held) */
+    s->hunted_at_kmh = a->hunted_at_kmh, s->hunted_at_s = a->hunted_t_s;
+  return HM_LEVEL_ALARM;
+}
+
+/* The speed's trend, smoothed over HM_ALARM_TREND_S (accelerating toward a threshold makes a lower level
+ * short-lived). */
+static void follow_trend(hm_alarm a, double now, double v_kmh) {
+  if (a->have_trend && now > a->t_prev_s) {
+    const double dt = now - a->t_prev_s, w = fmin(dt / HM_ALARM_TREND_S, 1.0);
+    a->dvdt_kmh_s += w * ((v_kmh - a->v_prev_kmh) / dt - a->dvdt_kmh_s);
   }
-  hold_numbers(a, now, &s);
-  /* (with no data the latch is kept: nothing says the oscillation has gone) */
-  s.changed = 0;
+  a->have_trend = 1;
+  a->v_prev_kmh = v_kmh;
+  a->t_prev_s = now;
+}
+
+/* With current data: the boundaries and margins into s, the level wanted into *target with its reason; *released
+ * when the latch let go. The assessment's status on failure. */
+static hm_status target_with_data(hm_alarm a, const hm_estimate *e, const hm_margin_estimate *g, double now,
+                                  hm_assessment *s, hm_level *target, hm_reason *reason, int *released) {
+  const hm_status st = assess(a, e, g, s);
+  if (st != HM_OK) return st;
+  s->boundaries_valid = 1;
+  s->narrow_peak_ambiguous = g && g->ambiguous_at_s > 0.0 && now - g->ambiguous_at_s <= HM_ALARM_NARROW_HOLD_S;
+  s->margin_hopf_kmh = s->boundaries.hopf_speed_kmh - e->speed_kmh;
+  s->margin_lowest_cycle_kmh = s->boundaries.lowest_cycle_speed_kmh - e->speed_kmh;
+  s->amplitude_m = e->oscillation_valid ? e->amplitude_displacement_m : 0.0;
+  s->amplitude_margin_m = s->edge_used_m > 0.0 ? s->edge_used_m - s->amplitude_m : 0.0;
+  hunted_bound(a, e, now, s);
+  follow_trend(a, now, e->speed_kmh);
+  /* (an identified interval only: the prior's range is already the cautious end of the wheels' wear) */
+  const double accel_kmh_s = sustained_acceleration(a, now, e->speed_kmh);
+  s->anticipation_kmh = s->conicity_from_estimate ? accel_kmh_s * HM_ALARM_RAISE_LOOKAHEAD_S : 0.0;
+  *target = raw_level(a, e, g, s, a->level, reason);
+  int kept = 0;
+  if (*target < a->level && a->dvdt_kmh_s > 0.0) {
+    /* a lower level only if it would still hold at the speed the present acceleration reaches in
+     * HM_ALARM_LOWER_LOOKAHEAD_S: a train accelerating past a threshold just lowered would raise the level again */
+    hm_estimate ahead = *e;
+    ahead.speed_kmh += a->dvdt_kmh_s * HM_ALARM_LOWER_LOOKAHEAD_S;
+    hm_reason r_ahead;
+    if (raw_level(a, &ahead, g, s, a->level, &r_ahead) >= a->level) *target = a->level, *reason = a->reason, kept = 1;
+  }
+  *released = latch(a, e, now, s, target, reason, kept);
+  return HM_OK;
+}
+
+/* The level moves to target: at once when higher, to NO_DATA or from it, or released; lower only after its
+ * conditions held for min_hold_s. s->changed says whether it moved. */
+static void move_level(hm_alarm a, double now, hm_level target, hm_reason reason, int released, hm_assessment *s) {
+  s->changed = 0;
   if (target >= a->level || target == HM_LEVEL_NO_DATA || a->level == HM_LEVEL_NO_DATA || released) {
     a->lower_pending = 0;
     if (target != a->level) {
       a->level = target;
       a->since = now;
-      s.changed = 1;
+      s->changed = 1;
     }
     a->reason = reason; /* the level's current cause */
-  } else {
-    /* a lower level is taken only after its conditions held for min_hold_s */
-    if (!a->lower_pending) {
-      a->lower_pending = 1;
-      a->lower_since = now;
-    }
-    if (now - a->lower_since >= c->min_hold_s) {
-      a->level = target;
-      a->reason = reason;
-      a->since = now;
-      a->lower_pending = 0;
-      s.changed = 1;
-    }
+    return;
   }
+  if (!a->lower_pending) {
+    a->lower_pending = 1;
+    a->lower_since = now;
+  }
+  if (now - a->lower_since >= a->cfg.min_hold_s) {
+    a->level = target;
+    a->reason = reason;
+    a->since = now;
+    a->lower_pending = 0;
+    s->changed = 1;
+  }
+}
+
+hm_status hm_alarm_update(hm_alarm a, const hm_estimate *e, const hm_margin_estimate *g, double now, hm_assessment *out) {
+  if (!a || !e || !out || !isfinite(now)) return HM_EINVAL;
+  hm_assessment s;
+  memset(&s, 0, sizeof s);
+  s.time_s = now;
+  s.speed_kmh = e->speed_valid ? e->speed_kmh : 0.0;
+  s.hunted_at_kmh = s.hunted_at_s = NAN;
+  hm_reason reason = HM_REASON_STARTUP;
+  hm_level target = HM_LEVEL_NO_DATA;
+  int released = 0;
+  if (!e->accel_valid || !e->speed_valid) {
+    target = target_without_data(a, e, &s, &reason);
+  } else {
+    const hm_status st = target_with_data(a, e, g, now, &s, &target, &reason, &released);
+    if (st != HM_OK) return st;
+  }
+  hold_numbers(a, now, &s);
+  /* (with no data the latch is kept: nothing says the oscillation has gone) */
+  move_level(a, now, target, reason, released, &s);
   s.level = a->level;
   s.reason = a->reason;
   s.level_since_s = a->since;
