@@ -1,7 +1,6 @@
 #include "monitor_ros.h"
 
 #include <hunting_monitor/HuntingAlarm.h>
-#include <hunting_monitor/HuntingStatus.h>
 #include <std_msgs/UInt8.h>
 #include <visualization_msgs/MarkerArray.h>
 
@@ -378,19 +377,43 @@ void MonitorRos::onTimer(const ros::TimerEvent&) {
   refineTable();
   last_ = st;
   have_last_ = true;
-  const hm_estimate& e = st.estimate;
   const hm_assessment& s = st.assessment;
   const hm_margin_estimate& g = st.margin;
-  hm_report r;  // every field gated once (report.h); NAN -> 0 beside its flag here
-  hm_report_make(&st, NAN, &r);  // times as ages: the sensor's line is no clock to read
-
+  if (g.n_changes != last_changes_) {
+    if (g.n_changes > last_changes_)
+      ROS_WARN("hunting_monitor: the conicity changed (a window %.0f s ago disagreed with those held): the "
+               "identification continues from that window, with the prior (the more cautious) until a second agrees",
+               lineTime(now) - g.last_change_s);
+    last_changes_ = g.n_changes;
+  }
   hunting_monitor::HuntingStatus m;
+  fillStatus(st, now, m);
+  status_pub_.publish(m);
+
+  publishLevel(s, m.reason, now);
+  if (static_cast<int>(s.level) != last_logged_level_) {
+    last_logged_level_ = static_cast<int>(s.level);
+    ROS_INFO("hunting_monitor: level %s (%s) at %.1f km/h", hm_level_name(s.level), hm_reason_text(s.reason),
+             st.estimate.speed_kmh);
+  }
+  publishMarkers(st, now);
+  const visualization_msgs::MarkerArray chart = chart_->update(st, hm_monitor_table(monitor_), now);
+  if (!chart.markers.empty()) chart_pub_.publish(chart);
+  updater_.update();
+}
+
+// The status message: the report's fields (every one gated once, report.h; NAN -> 0 beside its flag here) and what
+// only the node knows (stamps on ROS time, the sensor clock, the table's error and refinement).
+void MonitorRos::fillStatus(const hm_monitor_status& st, const ros::Time& now, hunting_monitor::HuntingStatus& m) {
+  hm_report r;
+  hm_report_make(&st, NAN, &r);  // times as ages: the sensor's line is no clock to read
+  const hm_estimate& e = st.estimate;
   m.header.stamp = now;
   m.header.frame_id = frame_id_;
   if (e.n_samples > 0) m.accel_stamp = ros::Time(rosTime(e.time_s));
   m.sensor_clock_offset_s = hm_clock_offset_s(&clock_);
   m.sensor_clock_steps = static_cast<uint32_t>(clock_.n_steps);
-  m.level = static_cast<uint8_t>(s.level);
+  m.level = static_cast<uint8_t>(st.assessment.level);
   m.reason_code = static_cast<uint8_t>(r.reason_code);
   m.reason = r.reason;
   m.level_latched = r.latched;
@@ -415,6 +438,12 @@ void MonitorRos::onTimer(const ros::TimerEvent&) {
   m.sample_rate_mismatch = r.sample_rate_mismatch;
   m.samples_lost = static_cast<uint64_t>(r.samples_lost);
   m.samples_lost_fraction = finite(r.samples_lost_fraction);
+  fillMode(r, m);
+  fillMargin(r, m);
+  fillBoundaries(r, st, m);
+}
+
+void MonitorRos::fillMode(const hm_report& r, hunting_monitor::HuntingStatus& m) {
   m.mode_valid = r.mode_valid;  // a fit over a changing speed is shown, not used (mode_verdict says why)
   m.mode_verdict = static_cast<uint8_t>(r.mode_window_verdict);
   m.mode_verdict_text = r.mode_window_verdict_text;
@@ -450,6 +479,9 @@ void MonitorRos::onTimer(const ros::TimerEvent&) {
   m.speed_tracking_measured = std::isfinite(r.mode_speed_tracking);
   m.mode_speed_tracking = finite(r.mode_speed_tracking);
   m.mode_speed_tracking_se = finite(r.mode_speed_tracking_se);
+}
+
+void MonitorRos::fillMargin(const hm_report& r, hunting_monitor::HuntingStatus& m) {
   m.conicity_valid = r.conicity_valid;
   m.conicity_estimate = finite(r.conicity_estimate);
   m.conicity_se = finite(r.conicity_se);
@@ -469,13 +501,10 @@ void MonitorRos::onTimer(const ros::TimerEvent&) {
   m.windows_since_change = static_cast<uint32_t>(r.windows_since_change);
   m.conicity_outside_prior = static_cast<int8_t>(r.conicity_outside_prior);
   if (std::isfinite(r.last_conicity_change_s)) m.last_conicity_change = ros::Time(rosTime(r.last_conicity_change_s));
-  if (g.n_changes != last_changes_) {
-    if (g.n_changes > last_changes_)
-      ROS_WARN("hunting_monitor: the conicity changed (a window %.0f s ago disagreed with those held): the "
-               "identification continues from that window, with the prior (the more cautious) until a second agrees",
-               lineTime(now) - g.last_change_s);
-    last_changes_ = g.n_changes;
-  }
+}
+
+void MonitorRos::fillBoundaries(const hm_report& r, const hm_monitor_status& st, hunting_monitor::HuntingStatus& m) {
+  const hm_assessment& s = st.assessment;
   m.boundaries_valid = r.boundaries_valid;  // never a stale margin presented as current
   m.conicity_used = finite(r.conicity_used);
   m.conicity_from_estimate = r.conicity_from_estimate;
@@ -512,18 +541,6 @@ void MonitorRos::onTimer(const ros::TimerEvent&) {
   m.criterion_rms_exceeded = r.rms_exceeded;
   m.criterion_peaks_exceeded = r.peaks_exceeded;
   m.criterion_displacement_exceeded = r.displacement_exceeded;
-  status_pub_.publish(m);
-
-  publishLevel(s, m.reason, now);
-  if (static_cast<int>(s.level) != last_logged_level_) {
-    last_logged_level_ = static_cast<int>(s.level);
-    ROS_INFO("hunting_monitor: level %s (%s) at %.1f km/h", hm_level_name(s.level), hm_reason_text(s.reason),
-             e.speed_kmh);
-  }
-  publishMarkers(st, now);
-  const visualization_msgs::MarkerArray chart = chart_->update(st, hm_monitor_table(monitor_), now);
-  if (!chart.markers.empty()) chart_pub_.publish(chart);
-  updater_.update();
 }
 
 void MonitorRos::publishLevel(const hm_assessment& s, const std::string& text, const ros::Time& now) {

@@ -4,6 +4,7 @@
 #define HUNTING_MONITOR_MONITOR_ROS_H
 
 #include <diagnostic_updater/diagnostic_updater.h>
+#include <hunting_monitor/HuntingStatus.h>
 #include <diagnostic_updater/update_functions.h>
 #include <ros/ros.h>
 #include <sensor_msgs/Imu.h>
@@ -20,6 +21,7 @@ extern "C" {
 #include "hunting_monitor/clock.h"
 #include "hunting_monitor/model.h"
 #include "hunting_monitor/monitor.h"
+#include "hunting_monitor/report.h"
 #include "hunting_monitor/state.h"
 }
 
@@ -47,6 +49,11 @@ class MonitorRos {
   double lineTime(const ros::Time& now) { return hm_clock_to_sensor(&clock_, now.toSec()); }
   void timeJumped(const std::string& what, double delta_s);
   void onTimer(const ros::TimerEvent& ev);
+  // The HuntingStatus of one update, in parts: the mode and lines, the margin's estimates, the boundaries in use.
+  void fillStatus(const hm_monitor_status& st, const ros::Time& now, hunting_monitor::HuntingStatus& m);
+  void fillMode(const hm_report& r, hunting_monitor::HuntingStatus& m);
+  void fillMargin(const hm_report& r, hunting_monitor::HuntingStatus& m);
+  void fillBoundaries(const hm_report& r, const hm_monitor_status& st, hunting_monitor::HuntingStatus& m);
   void refineTable();
   void publishMarkers(const hm_monitor_status& st, const ros::Time& now);
   // The level on hunting_alarm (bare, on change) and hunting_alarm_stamped (on change of level or reason, and at
