@@ -35,90 +35,67 @@ static int read_profile(const char *path, hm_profile *p) {
   return 0;
 }
 
-int cmd_delta_r(const cli_args *a) {
-  const char *wp = cli_value(a, "wheel"), *rp = cli_value(a, "rail");
-  if (!wp || !rp) {
-    fprintf(stderr, "hunting delta-r: give the profiles: --wheel FILE.csv --rail FILE.csv (y_mm,z_mm)\n");
-    return 1;
-  }
-  hm_contact_config c;
-  hm_contact_config_default(&c);
-  double r0 = 1e3 * c.r0_left_m, r0r = NAN, incl = 40.0, gauge = 1e3 * c.gauge_m, depth = 1e3 * c.gauge_depth_m,
-         fb = 1e3 * c.flange_back_distance_m, mc = 1e3 * c.measuring_circle_m, max_shift = 8.0, step = 0.1;
+/* The contact settings from the options (mm, 1:N), checked by the core; 0, or 1 with the reason on stderr. *max_shift
+ * and *step [mm] the shifts' range and step. */
+static int contact_settings(const cli_args *a, hm_contact_config *c, double *max_shift, double *step) {
+  hm_contact_config_default(c);
+  double r0 = 1e3 * c->r0_left_m, r0r = NAN, incl = 40.0, gauge = 1e3 * c->gauge_m, depth = 1e3 * c->gauge_depth_m,
+         fb = 1e3 * c->flange_back_distance_m, mc = 1e3 * c->measuring_circle_m;
+  *max_shift = 8.0, *step = 0.1;
   if (cli_number(a, "r0-mm", &r0) || cli_number(a, "r0-right-mm", &r0r) || cli_number(a, "inclination", &incl) ||
       cli_number(a, "gauge-mm", &gauge) || cli_number(a, "gauge-depth-mm", &depth) ||
       cli_number(a, "flange-back-mm", &fb) || cli_number(a, "measuring-circle-mm", &mc) ||
-      cli_number(a, "max-shift-mm", &max_shift) || cli_number(a, "step-mm", &step))
+      cli_number(a, "max-shift-mm", max_shift) || cli_number(a, "step-mm", step))
     return 1;
   if (!(incl == 0.0 || incl >= 10.0)) {
     fprintf(stderr, "hunting delta-r: --inclination must be 0 (upright) or N >= 10 for 1:N (got %g)\n", incl);
     return 1;
   }
-  if (!(max_shift > 0.0 && max_shift <= 50.0) || !(step > 0.0 && step <= max_shift) || max_shift / step > 100000.0) {
+  if (!(*max_shift > 0.0 && *max_shift <= 50.0) || !(*step > 0.0 && *step <= *max_shift) ||
+      *max_shift / *step > 100000.0) {
     fprintf(stderr, "hunting delta-r: --max-shift-mm must be in (0, 50] and --step-mm in (0, max-shift], at most "
-                    "100000 steps each side (got %g and %g)\n", max_shift, step);
+                    "100000 steps each side (got %g and %g)\n", *max_shift, *step);
     return 1;
   }
-  c.r0_left_m = 1e-3 * r0;
-  c.r0_right_m = 1e-3 * (isnan(r0r) ? r0 : r0r);
-  c.inclination = incl == 0.0 ? 0.0 : 1.0 / incl;
-  c.gauge_m = 1e-3 * gauge;
-  c.gauge_depth_m = 1e-3 * depth;
-  c.flange_back_distance_m = 1e-3 * fb;
-  c.measuring_circle_m = 1e-3 * mc;
-  c.include_roll = cli_has(a, "roll");
+  c->r0_left_m = 1e-3 * r0;
+  c->r0_right_m = 1e-3 * (isnan(r0r) ? r0 : r0r);
+  c->inclination = incl == 0.0 ? 0.0 : 1.0 / incl;
+  c->gauge_m = 1e-3 * gauge;
+  c->gauge_depth_m = 1e-3 * depth;
+  c->flange_back_distance_m = 1e-3 * fb;
+  c->measuring_circle_m = 1e-3 * mc;
+  c->include_roll = cli_has(a, "roll");
   char why[256] = "";
-  if (hm_contact_config_validate(&c, why, sizeof why) != HM_OK) {
+  if (hm_contact_config_validate(c, why, sizeof why) != HM_OK) {
     fprintf(stderr, "hunting delta-r: %s (in m)\n", why);
     return 1;
   }
-  hm_profile wl = {0}, wr = {0}, rl = {0}, rr = {0};
-  const char *wrp = cli_value(a, "wheel-right"), *rrp = cli_value(a, "rail-right");
-  const size_t n = 2 * (size_t)floor(max_shift / step + 1e-9) + 1;
-  double *s = NULL;
-  hm_contact_point *p = NULL;
-  int rc = 1;
-  if (read_profile(wp, &wl) || read_profile(rp, &rl) || (wrp && read_profile(wrp, &wr)) ||
-      (rrp && read_profile(rrp, &rr)))
-    goto done;
-  s = malloc(n * sizeof *s);
-  p = malloc(n * sizeof *p);
-  if (!s || !p) {
-    rc = cli_fail_status("delta-r", HM_ENOMEM);
-    goto done;
-  }
-  for (size_t k = 0; k < n; ++k) s[k] = 1e-3 * step * ((double)k - (double)(n / 2));
-  const hm_status st =
-      hm_contact_delta_r(&c, &wl, wrp ? &wr : NULL, &rl, rrp ? &rr : NULL, s, n, p, why, sizeof why);
-  if (st != HM_OK) {
-    fprintf(stderr, "hunting delta-r: %s\n", why[0] ? why : hm_status_str(st));
-    goto done;
-  }
-  const char *out = cli_value(a, "out");
-  if (out) {
-    FILE *f = fopen(out, "w");
-    int bad = !f || fprintf(f, "y_mm,delta_r_mm\n") < 0;
-    for (size_t k = 0; !bad && k < n; ++k) bad = fprintf(f, "%.6f,%.9f\n", 1e3 * s[k], 1e3 * p[k].delta_r_m) < 0;
-    if (f && fclose(f) != 0) bad = 1;
-    if (bad) {
-      perror(out);
-      goto done;
-    }
-  }
+  return 0;
+}
+
+/* --out: delta-r as fit's CSV (y_mm,delta_r_mm); 0, or 1 with the reason on stderr. */
+static int write_delta_r_csv(const char *out, const double *s, const hm_contact_point *p, size_t n) {
+  FILE *f = fopen(out, "w");
+  int bad = !f || fprintf(f, "y_mm,delta_r_mm\n") < 0;
+  for (size_t k = 0; !bad && k < n; ++k) bad = fprintf(f, "%.6f,%.9f\n", 1e3 * s[k], 1e3 * p[k].delta_r_m) < 0;
+  if (f && fclose(f) != 0) bad = 1;
+  if (bad) perror(out);
+  return bad;
+}
+
+/* The JSON result: the settings and every column over the shifts; 0, or 1 out of memory. */
+static int write_delta_r_json(const hm_contact_config *c, const double *s, const hm_contact_point *p, size_t n) {
   double *col = malloc(n * sizeof *col);
-  if (!col) {
-    rc = cli_fail_status("delta-r", HM_ENOMEM);
-    goto done;
-  }
+  if (!col) return cli_fail_status("delta-r", HM_ENOMEM);
   json_writer w;
   jw_init(&w, stdout);
   jw_object(&w, NULL);
-  jw_number(&w, "inclination", c.inclination);
-  jw_bool(&w, "roll_included", c.include_roll);
-  jw_number(&w, "gauge_mm", gauge);
-  jw_number(&w, "flange_back_mm", fb);
-  jw_number(&w, "r0_left_mm", 1e3 * c.r0_left_m);
-  jw_number(&w, "r0_right_mm", 1e3 * c.r0_right_m);
+  jw_number(&w, "inclination", c->inclination);
+  jw_bool(&w, "roll_included", c->include_roll);
+  jw_number(&w, "gauge_mm", 1e3 * c->gauge_m);
+  jw_number(&w, "flange_back_mm", 1e3 * c->flange_back_distance_m);
+  jw_number(&w, "r0_left_mm", 1e3 * c->r0_left_m);
+  jw_number(&w, "r0_right_mm", 1e3 * c->r0_right_m);
   for (size_t k = 0; k < n; ++k) col[k] = 1e3 * s[k];
   jw_numbers(&w, "y_mm", col, n);
   for (size_t k = 0; k < n; ++k) col[k] = 1e3 * p[k].delta_r_m;
@@ -136,7 +113,44 @@ int cmd_delta_r(const cli_args *a) {
   jw_end_object(&w);
   jw_finish(&w);
   free(col);
-  rc = 0;
+  return 0;
+}
+
+int cmd_delta_r(const cli_args *a) {
+  const char *wp = cli_value(a, "wheel"), *rp = cli_value(a, "rail");
+  if (!wp || !rp) {
+    fprintf(stderr, "hunting delta-r: give the profiles: --wheel FILE.csv --rail FILE.csv (y_mm,z_mm)\n");
+    return 1;
+  }
+  hm_contact_config c;
+  double max_shift, step;
+  if (contact_settings(a, &c, &max_shift, &step)) return 1;
+  hm_profile wl = {0}, wr = {0}, rl = {0}, rr = {0};
+  const char *wrp = cli_value(a, "wheel-right"), *rrp = cli_value(a, "rail-right");
+  const size_t n = 2 * (size_t)floor(max_shift / step + 1e-9) + 1;
+  double *s = NULL;
+  hm_contact_point *p = NULL;
+  int rc = 1;
+  if (read_profile(wp, &wl) || read_profile(rp, &rl) || (wrp && read_profile(wrp, &wr)) ||
+      (rrp && read_profile(rrp, &rr)))
+    goto done;
+  s = malloc(n * sizeof *s);
+  p = malloc(n * sizeof *p);
+  if (!s || !p) {
+    rc = cli_fail_status("delta-r", HM_ENOMEM);
+    goto done;
+  }
+  for (size_t k = 0; k < n; ++k) s[k] = 1e-3 * step * ((double)k - (double)(n / 2));
+  char why[256] = "";
+  const hm_status st =
+      hm_contact_delta_r(&c, &wl, wrp ? &wr : NULL, &rl, rrp ? &rr : NULL, s, n, p, why, sizeof why);
+  if (st != HM_OK) {
+    fprintf(stderr, "hunting delta-r: %s\n", why[0] ? why : hm_status_str(st));
+    goto done;
+  }
+  const char *out = cli_value(a, "out");
+  if (out && write_delta_r_csv(out, s, p, n)) goto done;
+  rc = write_delta_r_json(&c, s, p, n);
 done:
   free((void *)wl.y_m), free((void *)wr.y_m), free((void *)rl.y_m), free((void *)rr.y_m);
   free(s), free(p);

@@ -237,6 +237,110 @@ static void restore_state(const char *path, hm_monitor mon, double t0, hm_state_
   snprintf(text, len, "%s", o.text);
 }
 
+/* The vehicle model and its parameters from the options (a bogie's or car's kept in *cm); 0, or 1 with the reason on
+ * stderr. */
+static int estimate_model(const cli_args *a, cli_model *cm, hm_vehicle *veh, hm_model_kind *kind, hm_car *params) {
+  if (cli_model_kind(a, kind)) return 1;
+  if (*kind == HM_MODEL_WHEELSET ? cli_vehicle(a, veh, NULL) : cli_vehicle_model(a, *kind, cm)) return 1;
+  if (*kind == HM_MODEL_WHEELSET) {
+    hm_car_default(params);
+    params->bogie.wheelset = *veh;
+  } else {
+    *params = cm->params;
+  }
+  *veh = params->bogie.wheelset;
+  if (*kind != HM_MODEL_WHEELSET && (cli_has(a, "state-in") || cli_has(a, "state-out"))) {
+    fprintf(stderr, "hunting estimate: --state-in and --state-out take the wheelset model (not yet a %s)\n",
+            hm_model_kind_name(*kind));
+    return 1;
+  }
+  return 0;
+}
+
+/* The acceleration file's header and its first HEAD_ROWS rows into head (to infer the sample rate); *ended when that
+ * was all. 0, or 1 with the reason on stderr. */
+static int read_head(cli_csv *acc, const char *path, double *head, size_t *n_head, int *ended) {
+  if (strcmp(acc->header[0], "t_s") != 0 || strcmp(acc->header[1], "accel_mps2") != 0) {
+    fprintf(stderr, "hunting estimate: %s: the header must be 't_s,accel_mps2'\n", path);
+    return 1;
+  }
+  size_t n = 0, n_finite = 0;
+  int r = 1;
+  while (n < HEAD_ROWS && (r = cli_csv_next(acc, &head[2 * n])) == 1) n_finite += isfinite(head[2 * n++]) != 0;
+  *n_head = n;
+  *ended = r == 0;
+  if (r < 0) return 1;
+  if (*ended && n_finite < 2) {
+    fprintf(stderr, "hunting estimate: %s: %s\n", path,
+            n == 0 ? "no samples (only a header)" : "fewer than two samples with a finite time stamp");
+    return 1;
+  }
+  return 0;
+}
+
+/* The speed file opened into *spd (*open set) and its first row read into run; 0, or 1 with the reason on stderr. */
+static int open_speed(cli_csv *spd, const char *path, run_state *run, int *open) {
+  if (cli_csv_open(spd, path, 2, 1)) return 1;
+  *open = 1;
+  if (strcmp(spd->header[0], "t_s") != 0 || strcmp(spd->header[1], "speed_kmh") != 0) {
+    fprintf(stderr, "hunting estimate: %s: the header must be 't_s,speed_kmh'\n", path);
+    return 1;
+  }
+  const int s = cli_csv_next(spd, run->spd_next);
+  run->spd_have = s == 1;
+  run->counts.speed_rows = (unsigned long)run->spd_have;
+  run->spd = spd;
+  if (s < 0) return 1;
+  if (s == 0) {
+    fprintf(stderr, "hunting estimate: %s: no samples (only a header)\n", path);
+    return 1;
+  }
+  return 0;
+}
+
+/* The monitor of the model into run->mon (a table to compute computed on every processor); 0, or 1 with the reason
+ * on stderr. */
+static int create_monitor(const cli_args *a, const hm_monitor_config *cfg, hm_model_kind kind, const hm_car *params,
+                          hm_table table, run_state *run) {
+  char why[256] = "";
+  hm_threads threads = {0};
+  const hm_status st =
+      hm_monitor_create_model(cfg, kind, params, table, hm_threads_parallel_for, &threads, &run->mon, why, sizeof why);
+  if (st == HM_OK) return 0;
+  const int of_table = cli_value(a, "table") && strstr(why, "table") != NULL;
+  fprintf(stderr, "hunting estimate: %s%s%s\n", of_table ? cli_value(a, "table") : "",
+          of_table ? ": not for this vehicle: " : "", *why ? why : hm_status_str(st));
+  return 1;
+}
+
+/* After the data: one line at its end (its counters the whole run's, rows refused after the last line included), the
+ * state file, and a run that could use no speed or no acceleration refused whatever it printed (every line NO_DATA).
+ * 0, or 1 with the reason on stderr. */
+static int finish_run(run_state *run, const char *accel_path, const char *speed_path) {
+  if (isfinite(run->t_last) && (run->t_written < run->t_last || run->since_line > 0 ||
+                                run->counts.speed_rows_unused > 0)) {
+    hm_monitor_status st;
+    if (hm_monitor_update(run->mon, run->t_last, &st) == HM_OK)
+      write_line(&st, run->t_last, &run->counts, run->restored);
+  }
+  if (run->state_out && isfinite(run->t_last)) write_state(run, run->t_last); /* and at the end */
+  if (run->state_failed) return 1;
+  hm_monitor_status end;
+  if (!run->mon || !isfinite(run->t_last) || hm_monitor_update(run->mon, run->t_last, &end) != HM_OK) return 0;
+  const hm_estimate *e = &end.estimate;
+  if (e->n_speed_updates <= e->n_speed_rejected) { /* every speed refused, or none */
+    fprintf(stderr, "hunting estimate: %s: no usable speed (%lu rejected)\n", speed_path ? speed_path : "--v",
+            e->n_speed_rejected);
+    return 1;
+  }
+  if (e->n_samples == 0) {
+    fprintf(stderr, "hunting estimate: %s: no usable acceleration sample (%lu rejected)\n", accel_path,
+            e->n_rejected_nonfinite + e->n_rejected_range + e->n_rejected_order);
+    return 1;
+  }
+  return 0;
+}
+
 int cmd_estimate(const cli_args *a) {
   static cli_model cm; /* a bogie's or car's */
   hm_vehicle veh;
@@ -244,20 +348,7 @@ int cmd_estimate(const cli_args *a) {
   hm_car params;
   double every = 0.1, v_const = NAN;
   const char *accel_path = cli_value(a, "accel"), *speed_path = cli_value(a, "speed");
-  if (cli_model_kind(a, &kind)) return 1;
-  if (kind == HM_MODEL_WHEELSET ? cli_vehicle(a, &veh, NULL) : cli_vehicle_model(a, kind, &cm)) return 1;
-  if (kind == HM_MODEL_WHEELSET) {
-    hm_car_default(&params);
-    params.bogie.wheelset = veh;
-  } else {
-    params = cm.params;
-  }
-  veh = params.bogie.wheelset;
-  if (kind != HM_MODEL_WHEELSET && (cli_has(a, "state-in") || cli_has(a, "state-out"))) {
-    fprintf(stderr, "hunting estimate: --state-in and --state-out take the wheelset model (not yet a %s)\n",
-            hm_model_kind_name(kind));
-    return 1;
-  }
+  if (estimate_model(a, &cm, &veh, &kind, &params)) return 1;
   if (cli_number(a, "every", &every) || cli_number(a, "v", &v_const)) return 1;
   if (!accel_path || (!speed_path) == !cli_has(a, "v") || !(every > 0.0)) {
     fprintf(stderr, "hunting estimate: need --accel FILE and exactly one of --speed FILE or --v KM/H; --every > 0\n");
@@ -270,62 +361,20 @@ int cmd_estimate(const cli_args *a) {
   /* recordings of any length are streamed: only the first HEAD_ROWS rows are held, to infer the sample rate */
   cli_csv acc, spd;
   if (cli_csv_open(&acc, accel_path, 2, 1)) return 1;
-  int rc = 0, spd_open = 0;
-  if (strcmp(acc.header[0], "t_s") != 0 || strcmp(acc.header[1], "accel_mps2") != 0) {
-    fprintf(stderr, "hunting estimate: %s: the header must be 't_s,accel_mps2'\n", accel_path);
-    rc = 1;
-  }
   static double head[2 * HEAD_ROWS];
-  size_t n_head = 0, n_finite = 0;
-  int r = 1;
-  while (rc == 0 && n_head < HEAD_ROWS && (r = cli_csv_next(&acc, &head[2 * n_head])) == 1)
-    n_finite += isfinite(head[2 * n_head++]) != 0;
-  if (r < 0) rc = 1;
-  const int ended = r == 0;
-  if (rc == 0 && ended && n_finite < 2) {
-    fprintf(stderr, "hunting estimate: %s: %s\n", accel_path,
-            n_head == 0 ? "no samples (only a header)" : "fewer than two samples with a finite time stamp");
-    rc = 1;
-  }
+  size_t n_head = 0;
+  int ended = 0, spd_open = 0;
+  int rc = read_head(&acc, accel_path, head, &n_head, &ended);
   run_state run = {NULL, &veh, every, v_const, NAN, -INFINITY, -INFINITY, 0, 0, NULL, {0.0, 0.0}, 0, {0, 0, 0},
                    NULL, NULL, 0.0, NAN, 0};
   hm_state_clock clock = HM_STATE_CLOCK_LINE;
   if (rc == 0) rc = state_options(a, &run, &clock);
-  if (rc == 0 && speed_path) {
-    rc = cli_csv_open(&spd, speed_path, 2, 1);
-    spd_open = rc == 0;
-    if (rc == 0 && (strcmp(spd.header[0], "t_s") != 0 || strcmp(spd.header[1], "speed_kmh") != 0)) {
-      fprintf(stderr, "hunting estimate: %s: the header must be 't_s,speed_kmh'\n", speed_path);
-      rc = 1;
-    }
-    if (rc == 0) {
-      const int s = cli_csv_next(&spd, run.spd_next);
-      run.spd_have = s == 1;
-      run.counts.speed_rows = (unsigned long)run.spd_have;
-      if (s < 0) rc = 1;
-      if (s == 0) {
-        fprintf(stderr, "hunting estimate: %s: no samples (only a header)\n", speed_path);
-        rc = 1;
-      }
-      run.spd = &spd;
-    }
-  }
+  if (rc == 0 && speed_path) rc = open_speed(&spd, speed_path, &run, &spd_open);
   hm_monitor_config cfg;
   hm_table table = NULL;
   if (rc == 0) rc = load_settings(a, head, n_head, &cfg);
   if (rc == 0) rc = load_table(a, &table);
-  if (rc == 0) {
-    char why[256] = "";
-    hm_threads threads = {0}; /* a table to compute is computed on every processor */
-    const hm_status st = hm_monitor_create_model(&cfg, kind, &params, table, hm_threads_parallel_for, &threads,
-                                                 &run.mon, why, sizeof why);
-    if (st != HM_OK) {
-      const int of_table = cli_value(a, "table") && strstr(why, "table") != NULL;
-      fprintf(stderr, "hunting estimate: %s%s%s\n", of_table ? cli_value(a, "table") : "",
-              of_table ? ": not for this vehicle: " : "", *why ? why : hm_status_str(st));
-      rc = 1;
-    }
-  }
+  if (rc == 0) rc = create_monitor(a, &cfg, kind, &params, table, &run);
   static char restored[HM_STATE_TEXT_MAX];
   for (size_t i = 0; rc == 0 && cli_value(a, "state-in") && i < n_head; ++i)
     if (isfinite(head[2 * i])) { /* at the first sample: its time is the restored ages' now */
@@ -335,30 +384,10 @@ int cmd_estimate(const cli_args *a) {
     }
   for (size_t i = 0; rc == 0 && i < n_head; ++i) rc = process_row(&run, &head[2 * i], ended && i + 1 == n_head);
   double row[2];
+  int r;
   while (rc == 0 && !ended && (r = cli_csv_next(&acc, row)) != 0) rc = r < 0 ? 1 : process_row(&run, row, 0);
   if (rc == 0 && run.spd) rc = push_speeds_until(&run, INFINITY); /* the rest, after the acceleration's end */
-  /* one line at the end of the data: its counters are the whole run's (rows refused after the last line included) */
-  if (rc == 0 && isfinite(run.t_last) && (run.t_written < run.t_last || run.since_line > 0 ||
-                                          run.counts.speed_rows_unused > 0)) {
-    hm_monitor_status st;
-    if (hm_monitor_update(run.mon, run.t_last, &st) == HM_OK) write_line(&st, run.t_last, &run.counts, run.restored);
-  }
-  if (rc == 0 && run.state_out && isfinite(run.t_last)) write_state(&run, run.t_last); /* and at the end */
-  if (rc == 0 && run.state_failed) rc = 1;
-  /* a run that could use no speed or no acceleration is an error, whatever it printed (every line NO_DATA) */
-  hm_monitor_status end;
-  if (rc == 0 && run.mon && isfinite(run.t_last) && hm_monitor_update(run.mon, run.t_last, &end) == HM_OK) {
-    const hm_estimate *e = &end.estimate;
-    if (e->n_speed_updates <= e->n_speed_rejected) { /* every speed refused, or none */
-      fprintf(stderr, "hunting estimate: %s: no usable speed (%lu rejected)\n", speed_path ? speed_path : "--v",
-              e->n_speed_rejected);
-      rc = 1;
-    } else if (e->n_samples == 0) {
-      fprintf(stderr, "hunting estimate: %s: no usable acceleration sample (%lu rejected)\n", accel_path,
-              e->n_rejected_nonfinite + e->n_rejected_range + e->n_rejected_order);
-      rc = 1;
-    }
-  }
+  if (rc == 0) rc = finish_run(&run, accel_path, speed_path);
   hm_monitor_destroy(run.mon);
   cli_csv_close(&acc);
   if (spd_open) cli_csv_close(&spd);
