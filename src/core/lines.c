@@ -80,23 +80,13 @@ size_t hm_lines_mark(const hm_lines l, double f, double ratio, double spread_rel
   return marked;
 }
 
-hm_status hm_lines_find(hm_lines l, const double *p, size_t n, double df, double T, double f_lo, double f_hi,
-                        double spread_rel, unsigned char *exclude, hm_lines_result *out) {
-  if (!l || !p || !exclude || !out || n == 0 || n > l->max_bins || !(df > 0.0) || !(T > 0.0)) return HM_EINVAL;
+/* The candidates in bins k_lo..k_hi: local maxima over +- a main lobe (at least two bins) at least candidate_ratio above
+ * their local background, the median of the bins within +-h; at most MAX_CANDIDATES, the strongest kept. Their
+ * count before that limit in *seen. */
+static size_t find_candidates(hm_lines l, const double *p, size_t n, double df, double T, size_t k_lo, size_t k_hi,
+                              size_t h, candidate *cand, unsigned *seen) {
   const hm_lines_config *c = &l->cfg;
-  hm_lines_result r;
-  memset(&r, 0, sizeof r);
-  memset(exclude, 0, n);
-  const size_t h = (size_t)fmax(2.0, round(c->background_halfwidth_hz / df));
-  size_t k_lo = (size_t)fmax(1.0, ceil(f_lo / df)), k_hi = (size_t)fmin((double)(n - 2), floor(f_hi / df));
-  if (k_hi <= k_lo + 2) {
-    *out = r;
-    return HM_OK;
-  }
-  /* the candidates: local maxima over +- a main lobe (at least two bins) at least candidate_ratio above their local
-   * background, the median of the bins within +-h */
   const size_t lobe = (size_t)fmax(2.0, round(0.5 / (T * df)));
-  candidate cand[MAX_CANDIDATES];
   size_t nc = 0;
   for (size_t k = k_lo; k <= k_hi; ++k) {
     int is_max = 1;
@@ -115,7 +105,7 @@ hm_status hm_lines_find(hm_lines l, const double *p, size_t n, double df, double
     if (!(bg > 0.0)) continue;
     const double ratio = p[k] / bg;
     if (ratio < c->candidate_ratio) continue;
-    ++r.candidates;
+    ++*seen;
     /* the parabola through the logarithms of the three bins at the peak */
     const double ym = log(fmax(p[k - 1], 1e-300)), y0 = log(p[k]), yp = log(fmax(p[k + 1], 1e-300));
     const double den = ym - 2.0 * y0 + yp;
@@ -130,11 +120,22 @@ hm_status hm_lines_find(hm_lines l, const double *p, size_t n, double df, double
       if (cand[weakest].ratio < ratio) cand[weakest] = cd;
     }
   }
-  /* the comb that best explains the candidates: each one on a tooth counts 1, each tooth in the range without one
-   * costs 1/2 (a sub-harmonic comb f1 / j holds every line of f1 and chance candidates, but misses most of its
-   * teeth); then the largest spacing */
+  return nc;
+}
+
+/* A tooth's half-width [Hz] (lines.h): a candidate within it of m f1, f1 a candidate's frequency over d, is on the
+ * comb (the candidate's own error, half a bin of 1 / T, plus f1's carried to the m-th multiple, m / d of it). The
+ * search uses it with its d; the fit through the matched harmonics and the lines left out with d = 1 (wider). */
+static double tooth_halfwidth(double m, int d, double T) { return (0.5 + 0.5 * m / d) / T; }
+
+/* The comb that best explains the candidates (lines.h): each one on a tooth counts 1, each tooth in the range without
+ * one costs 1/2 (a sub-harmonic comb f1 / j holds every line of f1 and chance candidates, but misses most of its
+ * teeth); then the largest spacing. Its spacing (0 if none), its divisor and its count of candidates on a tooth. */
+static double best_comb(const hm_lines_config *c, const candidate *cand, size_t nc, double T, double f_lo, double f_hi,
+                        int *d_out, unsigned *count_out) {
   double best_f1 = 0.0, best_score = -INFINITY;
   unsigned best_count = 0;
+  int best_d = 1;
   for (size_t i = 0; i < nc; ++i)
     for (int d = 1; d <= MAX_DIVISOR; ++d) {
       const double f1 = cand[i].f / d;
@@ -142,57 +143,93 @@ hm_status hm_lines_find(hm_lines l, const double *p, size_t n, double df, double
       unsigned count = 0;
       for (size_t j = 0; j < nc; ++j) {
         const double m = floor(cand[j].f / f1 + 0.5);
-        if (m >= 1.0 && fabs(cand[j].f - m * f1) <= (0.5 + 0.5 * m / d) / T) ++count;
+        if (m >= 1.0 && fabs(cand[j].f - m * f1) <= tooth_halfwidth(m, d, T)) ++count;
       }
       const double teeth = floor(f_hi / f1) - ceil(f_lo / f1) + 1.0;
       const double score = (double)count - 0.5 * fmax(0.0, teeth - (double)count);
       if (score > best_score || (score == best_score && f1 > best_f1))
-        best_score = score, best_count = count, best_f1 = f1;
+        best_score = score, best_count = count, best_f1 = f1, best_d = d;
     }
-  /* where fewer whole multiples of the spacing fit in the range than min_harmonics, all of them (at least two) */
-  const double best_teeth = best_f1 > 0.0 ? floor(f_hi / best_f1) - ceil(f_lo / best_f1) + 1.0 : 0.0;
-  const unsigned needed = (unsigned)fmax(2.0, fmin((double)c->min_harmonics, best_teeth));
-  r.found = best_count >= needed;
-  unsigned char on_comb[MAX_CANDIDATES] = {0};
-  if (r.found) {
-    /* least squares through the matched harmonics: f_j = m_j f1 */
-    double smf = 0.0, smm = 0.0;
-    for (size_t j = 0; j < nc; ++j) {
-      const double m = floor(cand[j].f / best_f1 + 0.5);
-      if (m >= 1.0 && fabs(cand[j].f - m * best_f1) <= (0.5 + 0.5 * m) / T) {
-        on_comb[j] = 1;
-        smf += m * cand[j].f, smm += m * m;
-        if (cand[j].ratio > r.strongest_ratio) {
-          r.strongest_ratio = cand[j].ratio;
-          r.strongest_hz = cand[j].f;
-          r.strongest_bin = cand[j].k;
-        }
+  *d_out = best_d;
+  *count_out = best_count;
+  return best_f1;
+}
+
+/* The comb of spacing f1 into r: the least-squares spacing through the matched harmonics (f_j = m_j f1), its strongest
+ * line, and every multiple in the range left out over its line's leakage (exclude); on_comb marks the candidates
+ * matched. */
+static void take_comb(hm_lines l, const candidate *cand, size_t nc, double f1_search, double T, double f_hi,
+                      double spread_rel, size_t n, double df, unsigned char *exclude, unsigned char *on_comb,
+                      hm_lines_result *r) {
+  double smf = 0.0, smm = 0.0;
+  for (size_t j = 0; j < nc; ++j) {
+    const double m = floor(cand[j].f / f1_search + 0.5);
+    if (m >= 1.0 && fabs(cand[j].f - m * f1_search) <= tooth_halfwidth(m, 1, T)) {
+      on_comb[j] = 1;
+      smf += m * cand[j].f, smm += m * m;
+      if (cand[j].ratio > r->strongest_ratio) {
+        r->strongest_ratio = cand[j].ratio;
+        r->strongest_hz = cand[j].f;
+        r->strongest_bin = cand[j].k;
       }
     }
-    const double f1 = smm > 0.0 ? smf / smm : best_f1;
-    r.fundamental_hz = f1;
-    r.harmonics = best_count;
-    /* every multiple in the range, over its line's leakage */
-    for (double m = 1.0; m * f1 <= f_hi + c->background_halfwidth_hz; m += 1.0) {
-      const double fm = m * f1;
-      double ratio = 1.0;
-      for (size_t j = 0; j < nc; ++j)
-        if (fabs(cand[j].f - fm) <= (0.5 + 0.5 * m) / T) ratio = fmax(ratio, cand[j].ratio);
-      r.bins_excluded += hm_lines_mark(l, fm, ratio, spread_rel, n, df, T, exclude);
-    }
   }
-  /* the candidates on no comb, strongest first (a candidate taken is marked 2) */
+  const double f1 = smm > 0.0 ? smf / smm : f1_search;
+  r->fundamental_hz = f1;
+  /* every multiple in the range, over its line's leakage */
+  for (double m = 1.0; m * f1 <= f_hi + l->cfg.background_halfwidth_hz; m += 1.0) {
+    const double fm = m * f1;
+    double ratio = 1.0;
+    for (size_t j = 0; j < nc; ++j)
+      if (fabs(cand[j].f - fm) <= tooth_halfwidth(m, 1, T)) ratio = fmax(ratio, cand[j].ratio);
+    r->bins_excluded += hm_lines_mark(l, fm, ratio, spread_rel, n, df, T, exclude);
+  }
+}
+
+/* The candidates on no comb into r's lone lines, strongest first (a candidate taken is marked 2). */
+static void take_lone(const candidate *cand, size_t nc, unsigned char *on_comb, hm_lines_result *r) {
   for (unsigned slot = 0; slot < HM_LINES_MAX_LONE; ++slot) {
     size_t best = nc;
     for (size_t j = 0; j < nc; ++j)
       if (!on_comb[j] && (best == nc || cand[j].ratio > cand[best].ratio)) best = j;
     if (best == nc) break;
     on_comb[best] = 2;
-    r.lone_hz[slot] = cand[best].f;
-    r.lone_ratio[slot] = cand[best].ratio;
-    r.lone_bin[slot] = cand[best].k;
-    r.n_lone = slot + 1;
+    r->lone_hz[slot] = cand[best].f;
+    r->lone_ratio[slot] = cand[best].ratio;
+    r->lone_bin[slot] = cand[best].k;
+    r->n_lone = slot + 1;
   }
+}
+
+hm_status hm_lines_find(hm_lines l, const double *p, size_t n, double df, double T, double f_lo, double f_hi,
+                        double spread_rel, unsigned char *exclude, hm_lines_result *out) {
+  if (!l || !p || !exclude || !out || n == 0 || n > l->max_bins || !(df > 0.0) || !(T > 0.0)) return HM_EINVAL;
+  const hm_lines_config *c = &l->cfg;
+  hm_lines_result r;
+  memset(&r, 0, sizeof r);
+  memset(exclude, 0, n);
+  const size_t h = (size_t)fmax(2.0, round(c->background_halfwidth_hz / df));
+  size_t k_lo = (size_t)fmax(1.0, ceil(f_lo / df)), k_hi = (size_t)fmin((double)(n - 2), floor(f_hi / df));
+  if (k_hi <= k_lo + 2) {
+    *out = r;
+    return HM_OK;
+  }
+  candidate cand[MAX_CANDIDATES];
+  const size_t nc = find_candidates(l, p, n, df, T, k_lo, k_hi, h, cand, &r.candidates);
+  unsigned best_count = 0;
+  int best_d = 1; /* (the search's divisor of the comb kept) */
+  const double best_f1 = best_comb(c, cand, nc, T, f_lo, f_hi, &best_d, &best_count);
+  (void)best_d;
+  /* where fewer whole multiples of the spacing fit in the range than min_harmonics, all of them (at least two) */
+  const double best_teeth = best_f1 > 0.0 ? floor(f_hi / best_f1) - ceil(f_lo / best_f1) + 1.0 : 0.0;
+  const unsigned needed = (unsigned)fmax(2.0, fmin((double)c->min_harmonics, best_teeth));
+  r.found = best_count >= needed;
+  unsigned char on_comb[MAX_CANDIDATES] = {0};
+  if (r.found) {
+    r.harmonics = best_count;
+    take_comb(l, cand, nc, best_f1, T, f_hi, spread_rel, n, df, exclude, on_comb, &r);
+  }
+  take_lone(cand, nc, on_comb, &r);
   *out = r;
   return HM_OK;
 }

@@ -771,6 +771,46 @@ static void take_window(hm_modal m, size_t n, hm_mode_estimate *r) {
   r->order_line_mps2 = o.amp_mps2[best];
 }
 
+/* The geometry of a fit over the newest n decimated samples (padded to nfft) and the band's bins. */
+static window_geometry geometry(const hm_modal m, size_t n, double speed_spread_rel) {
+  window_geometry g;
+  g.df = m->fd / (double)m->nfft;
+  g.T = (double)n / m->fd;
+  g.w_ref = 2.0 * HM_PI * 0.5 * (m->cfg.band_low_hz + m->cfg.band_high_hz);
+  g.padding = (double)m->nfft / (double)n;
+  g.spread_rel = isfinite(speed_spread_rel) && speed_spread_rel > 0.0 ? speed_spread_rel : 0.0;
+  g.k0 = (size_t)ceil(m->cfg.band_low_hz / g.df);
+  g.k1 = (size_t)fmin(floor(m->cfg.band_high_hz / g.df), (double)(m->nfft / 2));
+  return g;
+}
+
+/* A narrow peak (modal.h): reported as such, and the reading with its line set aside too (r->line_reading), then,
+ * where that line lies inside the peak of the mode beside it, with the line's skirt left out as well
+ * (r->line_reading_wide; skirt_aside: a narrow mode's own core is no skirt: left out, the flanks of a bogie's mode at
+ * -0.6 1/s read -5.5). */
+static void narrow_peak_readings(hm_modal m, const window_geometry *g, const hm_lines_sinusoid *fit, double bg,
+                                 size_t n, hm_mode_estimate *r) {
+  r->narrow_peak = 1;
+  r->narrow_peak_hz = fit->omega * m->fd / (2.0 * HM_PI);
+  r->narrow_peak_mps2 = 2.0 * hypot(fit->amp_re, fit->amp_im);
+  const unsigned listed = r->lone_lines;
+  set_line_aside(m, g, fit, bg, n, r);
+  r->lone_lines = listed; /* the narrow peak is reported as such, not as a lone line */
+  double th_l[NPM], scale;
+  unsigned poles_l;
+  size_t nb_l = load_bins(m, g, m->set_aside, &scale);
+  const int ok = nb_l >= 4 * HM_WHITTLE_NP2 && fit_reading(m, &m->warm[1], g, nb_l, &r->line_reading, th_l, &poles_l);
+  if (!ok) memset(&r->line_reading, 0, sizeof r->line_reading);
+  r->line_reading_wide = r->line_reading;
+  if (ok && isfinite(r->line_reading.decay_rate_1_s) && in_peak(g, &r->line_reading, r->narrow_peak_hz) &&
+      skirt_aside(m, g, r->narrow_peak_hz) > 0) {
+    if (!m->warm[2].have1) m->warm[2] = m->warm[1]; /* from the main-lobe reading's, then its own */
+    nb_l = load_bins(m, g, m->set_aside, &scale);
+    if (nb_l < 4 * HM_WHITTLE_NP2 || !fit_reading(m, &m->warm[2], g, nb_l, &r->line_reading_wide, th_l, &poles_l))
+      memset(&r->line_reading_wide, 0, sizeof r->line_reading_wide);
+  }
+}
+
 hm_status hm_modal_fit(hm_modal m, double max_window_s, double speed_spread_rel, double halves_speed_ratio,
                        hm_mode_estimate *out) {
   if (!m || !out || !(max_window_s > 0.0)) return HM_EINVAL;
@@ -786,14 +826,7 @@ hm_status hm_modal_fit(hm_modal m, double max_window_s, double speed_spread_rel,
   }
   take_window(m, n, &r);
   periodogram(m, n);
-  window_geometry g;
-  g.df = m->fd / (double)m->nfft;
-  g.T = r.window_s;
-  g.w_ref = 2.0 * HM_PI * 0.5 * (m->cfg.band_low_hz + m->cfg.band_high_hz);
-  g.padding = (double)m->nfft / (double)n;
-  g.spread_rel = isfinite(speed_spread_rel) && speed_spread_rel > 0.0 ? speed_spread_rel : 0.0;
-  g.k0 = (size_t)ceil(m->cfg.band_low_hz / g.df);
-  g.k1 = (size_t)fmin(floor(m->cfg.band_high_hz / g.df), (double)(m->nfft / 2));
+  const window_geometry g = geometry(m, n, speed_spread_rel);
   hm_lines_result lr;
   find_comb(m, n, g.df, g.T, g.spread_rel, &lr, &r);
   /* the window's reading, without the comb; then without the lone lines it does not explain */
@@ -839,30 +872,7 @@ hm_status hm_modal_fit(hm_modal m, double max_window_s, double speed_spread_rel,
   for (size_t k = g.k0; k <= g.k1; ++k) ++n_band, n_out += m->set_aside[k] != 0;
   r.band_excluded_fraction = n_band ? (double)n_out / (double)n_band : 0.0;
   memcpy(m->excluded, m->set_aside, m->nfft / 2 + 1); /* the order tracking's bins (centroid) */
-  if (narrow >= 0) { /* the reading with that line set aside too */
-    r.narrow_peak = 1;
-    r.narrow_peak_hz = fits[narrow].omega * m->fd / (2.0 * HM_PI);
-    r.narrow_peak_mps2 = 2.0 * hypot(fits[narrow].amp_re, fits[narrow].amp_im);
-    const unsigned listed = r.lone_lines;
-    set_line_aside(m, &g, &fits[narrow], bgs[narrow], n, &r);
-    r.lone_lines = listed; /* the narrow peak is reported as such, not as a lone line */
-    double th_l[NPM];
-    unsigned poles_l;
-    size_t nb_l = load_bins(m, &g, m->set_aside, &scale);
-    int ok = nb_l >= 4 * HM_WHITTLE_NP2 && fit_reading(m, &m->warm[1], &g, nb_l, &r.line_reading, th_l, &poles_l);
-    if (!ok) memset(&r.line_reading, 0, sizeof r.line_reading);
-    r.line_reading_wide = r.line_reading;
-    /* the line inside the peak of the mode beside it: that mode again with the line's skirt left out too
-     * (skirt_aside), for where the peak is known for a line (a narrow mode's own core is no skirt: left out, the
-     * flanks of a bogie's mode at -0.6 1/s read -5.5) */
-    if (ok && isfinite(r.line_reading.decay_rate_1_s) && in_peak(&g, &r.line_reading, r.narrow_peak_hz) &&
-        skirt_aside(m, &g, r.narrow_peak_hz) > 0) {
-      if (!m->warm[2].have1) m->warm[2] = m->warm[1]; /* from the main-lobe reading's, then its own */
-      nb_l = load_bins(m, &g, m->set_aside, &scale);
-      if (nb_l < 4 * HM_WHITTLE_NP2 || !fit_reading(m, &m->warm[2], &g, nb_l, &r.line_reading_wide, th_l, &poles_l))
-        memset(&r.line_reading_wide, 0, sizeof r.line_reading_wide);
-    }
-  }
+  if (narrow >= 0) narrow_peak_readings(m, &g, &fits[narrow], bgs[narrow], n, &r);
   hm_mode_estimate_use_reading(&r, &rd);
   /* order tracking over the whole window (the peak is the same; a ramp's 24 s window alone leaves the halves' slope
    * three times as uncertain) */
