@@ -20,10 +20,9 @@
  *    (0.5 + 0.5 m / n) / T of whole multiples m f1 (f1 tried as each candidate's frequency over n = 1..12). The comb
  *    kept scores best: one per candidate on a tooth, less one half per tooth in the range without one (a
  *    sub-harmonic comb f1 / j holds every line of f1 and some chance candidates but misses most of its teeth), then
- *    the largest f1; f1 is then the least-squares fit through the harmonics within (0.5 + 0.5 m) / T of its
- *    multiples (the search's tolerance with n = 1: wider where f1 is a candidate over n > 1), which also picks each
- *    multiple's line for the width left out below. A lightly damped mode is one peak, not a comb: near the Hopf
- *    speed the mode itself is as narrow as a line and must not be left out.
+ *    the largest f1; f1 is then the least-squares fit through the harmonics matched by the same tolerance (with the
+ *    n of the f1 kept), which also picks each multiple's line for the width left out below. A lightly damped mode is
+ *    one peak, not a comb: near the Hopf speed the mode itself is as narrow as a line and must not be left out.
  *  - every multiple of f1 in the range is excluded over +-w, w = max(2 / T, sqrt(ratio / leakage) / (pi T)) (the
  *    rectangular window's leakage of a line `ratio` times its background falls below leakage of the background
  *    there), at most background_halfwidth_hz.

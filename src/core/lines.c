@@ -124,8 +124,8 @@ static size_t find_candidates(hm_lines l, const double *p, size_t n, double df, 
 }
 
 /* A tooth's half-width [Hz] (lines.h): a candidate within it of m f1, f1 a candidate's frequency over d, is on the
- * comb (the candidate's own error, half a bin of 1 / T, plus f1's carried to the m-th multiple, m / d of it). The
- * search uses it with its d; the fit through the matched harmonics and the lines left out with d = 1 (wider). */
+ * comb (the candidate's own error, half a bin of 1 / T, plus f1's carried to the m-th multiple, m / d of it). One rule
+ * for the search, the fit through the matched harmonics and the lines left out. */
 static double tooth_halfwidth(double m, int d, double T) { return (0.5 + 0.5 * m / d) / T; }
 
 /* The comb that best explains the candidates (lines.h): each one on a tooth counts 1, each tooth in the range without
@@ -158,13 +158,13 @@ static double best_comb(const hm_lines_config *c, const candidate *cand, size_t 
 /* The comb of spacing f1 into r: the least-squares spacing through the matched harmonics (f_j = m_j f1), its strongest
  * line, and every multiple in the range left out over its line's leakage (exclude); on_comb marks the candidates
  * matched. */
-static void take_comb(hm_lines l, const candidate *cand, size_t nc, double f1_search, double T, double f_hi,
+static void take_comb(hm_lines l, const candidate *cand, size_t nc, double f1_search, int d, double T, double f_hi,
                       double spread_rel, size_t n, double df, unsigned char *exclude, unsigned char *on_comb,
                       hm_lines_result *r) {
   double smf = 0.0, smm = 0.0;
   for (size_t j = 0; j < nc; ++j) {
     const double m = floor(cand[j].f / f1_search + 0.5);
-    if (m >= 1.0 && fabs(cand[j].f - m * f1_search) <= tooth_halfwidth(m, 1, T)) {
+    if (m >= 1.0 && fabs(cand[j].f - m * f1_search) <= tooth_halfwidth(m, d, T)) {
       on_comb[j] = 1;
       smf += m * cand[j].f, smm += m * m;
       if (cand[j].ratio > r->strongest_ratio) {
@@ -181,7 +181,7 @@ static void take_comb(hm_lines l, const candidate *cand, size_t nc, double f1_se
     const double fm = m * f1;
     double ratio = 1.0;
     for (size_t j = 0; j < nc; ++j)
-      if (fabs(cand[j].f - fm) <= tooth_halfwidth(m, 1, T)) ratio = fmax(ratio, cand[j].ratio);
+      if (fabs(cand[j].f - fm) <= tooth_halfwidth(m, d, T)) ratio = fmax(ratio, cand[j].ratio);
     r->bins_excluded += hm_lines_mark(l, fm, ratio, spread_rel, n, df, T, exclude);
   }
 }
@@ -217,9 +217,8 @@ hm_status hm_lines_find(hm_lines l, const double *p, size_t n, double df, double
   candidate cand[MAX_CANDIDATES];
   const size_t nc = find_candidates(l, p, n, df, T, k_lo, k_hi, h, cand, &r.candidates);
   unsigned best_count = 0;
-  int best_d = 1; /* (the search's divisor of the comb kept) */
+  int best_d = 1;
   const double best_f1 = best_comb(c, cand, nc, T, f_lo, f_hi, &best_d, &best_count);
-  (void)best_d;
   /* where fewer whole multiples of the spacing fit in the range than min_harmonics, all of them (at least two) */
   const double best_teeth = best_f1 > 0.0 ? floor(f_hi / best_f1) - ceil(f_lo / best_f1) + 1.0 : 0.0;
   const unsigned needed = (unsigned)fmax(2.0, fmin((double)c->min_harmonics, best_teeth));
@@ -227,7 +226,7 @@ hm_status hm_lines_find(hm_lines l, const double *p, size_t n, double df, double
   unsigned char on_comb[MAX_CANDIDATES] = {0};
   if (r.found) {
     r.harmonics = best_count;
-    take_comb(l, cand, nc, best_f1, T, f_hi, spread_rel, n, df, exclude, on_comb, &r);
+    take_comb(l, cand, nc, best_f1, best_d, T, f_hi, spread_rel, n, df, exclude, on_comb, &r);
   }
   take_lone(cand, nc, on_comb, &r);
   *out = r;

@@ -92,6 +92,26 @@ static void single_lines_and_noise_are_not_combs(void) {
   hm_lines_destroy(l);
 }
 
+/* One tooth rule for the comb (lines.h): a comb of 3 Hz whose spacing is found as a candidate over n = 2 (6 Hz / 2),
+ * with its fifth multiple missing and a peak 0.05 Hz beside where it would be (15.05 Hz: beyond the search's
+ * (0.5 + 0.5 * 5 / 2) / T = 0.044 Hz, within (0.5 + 0.5 * 5) / T = 0.075 Hz). On a flat spectrum with one-bin peaks
+ * (their frequencies exact at bin centres: no parabola shift) the comb's least-squares spacing is exactly 3 Hz
+ * through the five matched teeth (with the stray peak it would be 417.25 / 139 = 3.0018 Hz), and the stray peak is a
+ * lone line. */
+static void one_tooth_rule_for_the_comb(void) {
+  hm_lines l = make();
+  const double teeth[] = {6.0, 9.0, 12.0, 18.0, 21.0, 15.05};
+  for (int k = 0; k <= N / 2; ++k) power[k] = 1.0;
+  for (int i = 0; i < 6; ++i) power[(int)lround(teeth[i] * T)] = 100.0;
+  hm_lines_result r;
+  HM_CHECK(hm_lines_find(l, power, N / 2 + 1, FS / N, T, 5.0, 22.0, 0.0, excl, &r) == HM_OK && r.found, "found");
+  HM_CHECK_DELTA(r.fundamental_hz, 3.0, 1e-9, "the spacing through the matched teeth");
+  HM_CHECK(r.harmonics == 5, "teeth matched: %u", r.harmonics);
+  HM_CHECK(r.n_lone == 1 && fabs(r.lone_hz[0] - 15.05) < 1e-9, "the stray peak a lone line: %u at %g", r.n_lone,
+           r.n_lone ? r.lone_hz[0] : 0.0);
+  hm_lines_destroy(l);
+}
+
 static void bad_configuration_and_input(void) {
   hm_lines_config c;
   char why[128];
@@ -119,6 +139,7 @@ static void bad_configuration_and_input(void) {
 int main(void) {
   HM_RUN(comb_of_joints);
   HM_RUN(single_lines_and_noise_are_not_combs);
+  HM_RUN(one_tooth_rule_for_the_comb);
   HM_RUN(bad_configuration_and_input);
   HM_TEST_EXIT();
 }
