@@ -1,4 +1,4 @@
-/* The continuation engine (src/core/continuation.c) on curves with closed forms: a circle (points, tangents, the
+/* The continuation engine (src/core/bifurcation/continuation.c) on curves with closed forms: a circle (points, tangents, the
  * located fold), a line (step growth, the step limit, a failure wall, the branch-jump guard), and its options. */
 #include <string.h>
 

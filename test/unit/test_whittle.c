@@ -1,4 +1,4 @@
-/* The identification's spectral model and its Whittle fit (src/core/whittle.h, private) against spectra known in
+/* The identification's spectral model and its Whittle fit (src/core/monitor/whittle.h, private) against spectra known in
  * closed form: a periodogram equal to the model's own spectrum at known parameters has Whittle's optimum exactly
  * there (d/dtheta sum(ln S + I/S) = sum(1 - I/S) d ln S / dtheta = 0 at S = I), so the scoring must return them from
  * a start away from them; and the pair's term holds its power whatever its damping (the area of a Lorentzian). */
