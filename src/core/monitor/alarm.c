@@ -8,13 +8,8 @@
 #include <string.h>
 
 #include "hunting_monitor/linear.h"
+#include "evidence.h"
 #include "validate.h"
-
-/* A flag raised at once and cleared only after its condition has been false for HM_ALARM_FLAG_CLEAR_S (alarm.h). */
-typedef struct {
-  int on;
-  double false_since_s; /* NAN: the condition held at the last update */
-} sticky_flag;
 
 struct hm_alarm_s {
   hm_alarm_config cfg;            /* fallback and prior resolved for the vehicle */
@@ -42,12 +37,7 @@ struct hm_alarm_s {
   double hunted_mem_s;    /* when its memory_s started: hunted_t_s, or the latch's release if later (alarm.h: for
                              memory_s after the release; a latch longer than memory_s had dropped it at once) */
   double memory_s;        /* how long a hunted-at speed bounds the interval (hm_alarm_set_memory) */
-  int precise;            /* the estimate was used alone at the last update with data */
-  int se_ok;              /* its standard error was small enough at the last update with data (its hysteresis) */
-  int precise_lost;       /* it stopped being used alone: used again once it could have been since precise_since */
-  double precise_since;   /* (NAN: it could not be at the last update) */
-  sticky_flag mismatch, free_beside; /* model_mismatch, the model-free interval beside the model's (alarm.h) */
-  double free_low_kmh, free_high_kmh; /* the last valid model-free interval */
+  hm_evidence ev;         /* which estimates count, and their flags' memory (evidence.h) */
   double v_prev_kmh, t_prev_s, dvdt_kmh_s; /* the speed's trend: an exponential average of dv/dt over ~5 s */
   int have_trend;
   /* a sustained acceleration (alarm.h): the last speed, the mean of the block being filled and of the full blocks of
@@ -239,7 +229,7 @@ hm_status hm_alarm_create(const hm_alarm_config *cfg, const hm_vehicle *veh, con
     return st;
   }
   a->table = table;
-  a->precise_since = NAN;
+  a->ev.precise_since = NAN;
   a->hunted_at_kmh = INFINITY;
   a->memory_s = 900.0;
   a->level = HM_LEVEL_NO_DATA;
@@ -267,9 +257,7 @@ void hm_alarm_restart(hm_alarm a) {
   a->calm = 0;
   a->hunted_t_s = a->hunted_mem_s = NAN; /* its age counts again from the next update */
   a->latch_since_s = a->latch_last_met_s = NAN;
-  a->precise = a->precise_lost = a->se_ok = 0;
-  a->precise_since = NAN;
-  a->mismatch.on = a->free_beside.on = 0;
+  hm_evidence_restart(&a->ev);
   a->have_trend = 0;
   a->dvdt_kmh_s = 0.0;
   a->block_n = a->n_blocks = 0;
@@ -282,9 +270,7 @@ void hm_alarm_shift_time(hm_alarm a, double delta_s) {
   a->lower_since += delta_s;
   a->calm_since += delta_s;
   a->t_prev_s += delta_s;
-  a->precise_since += delta_s;
-  a->mismatch.false_since_s += delta_s;
-  a->free_beside.false_since_s += delta_s;
+  hm_evidence_shift_time(&a->ev, delta_s);
   a->hunted_t_s += delta_s;
   a->hunted_mem_s += delta_s;
   a->latch_since_s += delta_s;
@@ -476,120 +462,10 @@ static double sustained_acceleration(hm_alarm a, double now, double v_kmh) {
   return fmin(fmax(blocks_slope(a), 0.0), HM_ALARM_MAX_ACCEL_KMH_S);
 }
 
-static int sticky(sticky_flag *f, int condition, double now) {
-  if (condition) {
-    f->on = 1;
-    f->false_since_s = NAN;
-  } else if (f->on) {
-    if (isnan(f->false_since_s)) f->false_since_s = now;
-    if (now - f->false_since_s >= HM_ALARM_FLAG_CLEAR_S) f->on = 0;
-  }
-  return f->on;
-}
-
-/* The estimate's use alone (alarm.h): at once the first time, at once dropped, and once dropped taken again only after
- * its condition has held for HM_ALARM_FLAG_CLEAR_S. */
-static int regained(hm_alarm a, int condition, double now) {
-  if (!condition) {
-    if (a->precise) a->precise_lost = 1;
-    a->precise_since = NAN;
-    return 0;
-  }
-  if (isnan(a->precise_since)) a->precise_since = now;
-  if (a->precise_lost && now - a->precise_since < HM_ALARM_FLAG_CLEAR_S) return 0;
-  a->precise_lost = 0;
-  return 1;
-}
-
 /* WARN from an identified Hopf speed (alarm.h): the point less the larger of the margin and one standard error, the
  * lower half-width (point - low) being z of them. */
 static double warn_below_point(double point_kmh, double low_kmh, double margin_kmh, double z) {
   return point_kmh - fmax(margin_kmh, fmin((point_kmh - low_kmh) / z, HM_ALARM_WARN_MAX_BELOW_KMH));
-}
-
-/* What the evidence allows this update (alarm.h): which estimates count, each flag held against its chatter. */
-typedef struct {
-  int mismatch;      /* model_mismatch as the level uses it (sticky) */
-  int precise;       /* the estimate enters alone */
-  int usable;        /* the estimate counts, combined with the prior where not precise */
-  int free_alone;    /* the model-free interval is the only evidence of where the Hopf speed lies */
-  int free_counts;   /* the model-free interval's lower end counts (its last valid one, held) */
-} evidence;
-
-static evidence weigh_evidence(hm_alarm a, const hm_margin_estimate *g, double now) {
-  const hm_alarm_config *c = &a->cfg;
-  evidence ev;
-  /* a bogie's or car's model holds the frame: a frame sensor shows one of its modes (issue #28) */
-  const int axle = a->point == HM_POINT_WHEELSET || (a->model && hm_mode_model_kind(a->model) != HM_MODEL_WHEELSET);
-  const int have = c->use_conicity_estimate && g && g->conicity_valid && g->hopf_model_valid;
-  /* the margin's flags as the level uses them, held against the provisional window's chatter (alarm.h) */
-  ev.mismatch = sticky(&a->mismatch, g && g->model_mismatch, now);
-  /* the model-based interval counts from an axle-box sensor on a vehicle that behaves like its model (alarm.h) */
-  const int usable_model = have && axle && !ev.mismatch;
-  /* the standard error within conicity_max_se, once so within HM_ALARM_SE_HYSTERESIS times it (its own hysteresis,
-   * whatever else keeps the estimate from being used alone) */
-  const double max_se = a->se_ok ? HM_ALARM_SE_HYSTERESIS * c->conicity_max_se : c->conicity_max_se;
-  a->se_ok = usable_model && g->conicity_se <= max_se;
-  const int unconfirmed_change = g && g->n_changes > 0 && g->windows_since_change < 2;
-  /* an estimate enters alone when precise, inside the prior and not a change's first window (once it stopped being
-   * so, only after it has been so again for HM_ALARM_FLAG_CLEAR_S, meanwhile combined with the prior); otherwise
-   * combined with the prior (the more cautious): one precise but above the prior's range (its Hopf speed lower: worn
-   * beyond the prior), or any with a lightly damped mode held (alarm.h) */
-  const int alone = a->se_ok && !g->outside_prior && !unconfirmed_change;
-  ev.precise = regained(a, alone, now);
-  const int cautious_precise = a->se_ok && g->outside_prior > 0;
-  /* a change's first window, precise, is the evidence of the change (margin.h): combined with the prior (the more
-   * cautious) whatever its distance from the Hopf speed (issue #27: 0.12 -> 0.18 +- 0.008 at 300 km/h had left the
-   * prior alone, WATCH at 450 km/h above the new Hopf speed of 444.9) */
-  const int change_evidence = a->se_ok && unconfirmed_change;
-  ev.usable = ev.precise || alone || cautious_precise || change_evidence || (usable_model && g->near_evidence);
-  /* the model-free interval's lower end counts when the model-based one does not (a mismatch, a sensor off the axle
-   * box; then its upper end too: it is the only evidence of where the vehicle's Hopf speed lies, and on a bogie 40-60
-   * km/h less stable than the model it gave WARN a median 20 s before 3 mm, 5 s without), and beside it when its
-   * regression has residuals to check it (three windows or more) and a lightly damped mode is held: a zero crossing
-   * extrapolated from decay rates of -5..-11 1/s alone is wide (on a ramp from 271 to 301 km/h, 322 [309, ...] for a
-   * Hopf speed of 357) and its lower end is no evidence */
-  ev.free_alone = g && (ev.mismatch || !axle);
-  const int free_valid = g && g->hopf_free_valid;
-  if (free_valid) a->free_low_kmh = g->hopf_free_low_kmh, a->free_high_kmh = g->hopf_free_high_kmh;
-  const int free_beside = sticky(&a->free_beside,
-                                 free_valid && g->n_windows >= HM_ALARM_FREE_MIN_WINDOWS && g->near_evidence &&
-                                     !ev.free_alone,
-                                 now);
-  ev.free_counts = (free_valid && ev.free_alone) || free_beside; /* (held: its last valid interval) */
-  return ev;
-}
-
-/* The Hopf interval [lo, hi] the evidence gives, from the prior's, and the conicity in use with its optimistic end
- * (the interval's upper end's); s's provenance flags. */
-static void evidence_interval(const hm_alarm a, const hm_margin_estimate *g, const evidence *ev, double *lambda,
-                              double *lambda_opt, double *lo, double *hi, hm_assessment *s) {
-  const hm_alarm_config *c = &a->cfg;
-  *lambda = c->conicity_fallback, *lambda_opt = c->conicity_prior_low;
-  *lo = a->prior_hopf_low_kmh, *hi = a->prior_hopf_high_kmh;
-  s->conicity_from_estimate = ev->precise;
-  s->conicity_from_prior = !ev->precise;
-  s->model_interval_used = ev->usable;
-  s->conicity_se = 0.0;
-  if (ev->precise) {
-    *lambda = g->conicity;
-    *lambda_opt = g->conicity_low;
-    *lo = g->hopf_model_low_kmh;
-    *hi = g->hopf_model_high_kmh;
-    s->conicity_se = g->conicity_se;
-  } else if (ev->usable) {
-    if (g->hopf_model_kmh < hopf_kmh(&a->veh, a->model, *lambda)) *lambda = g->conicity, s->conicity_se = g->conicity_se;
-    *lo = fmin(*lo, g->hopf_model_low_kmh);
-    if (g->hopf_model_high_kmh < *hi) *hi = g->hopf_model_high_kmh, *lambda_opt = g->conicity_low;
-    /* the prior sets the interval only where the estimate moved neither end */
-    s->conicity_from_prior = *lo == a->prior_hopf_low_kmh && *hi == a->prior_hopf_high_kmh;
-  }
-  s->model_mismatch = ev->mismatch;
-  s->hopf_free_used = ev->free_counts;
-  if (ev->free_counts) {
-    *lo = fmin(*lo, a->free_low_kmh);
-    if (ev->free_alone && a->free_high_kmh < *hi) *hi = a->free_high_kmh;
-  }
 }
 
 /* The speed margins (alarm.h): added to a range's lower end; below an identified interval WATCH in quadrature with
@@ -597,7 +473,8 @@ static void evidence_interval(const hm_alarm a, const hm_margin_estimate *g, con
  * estimate too uncertain to be used alone (the vehicle behaving like its model) gives its own WARN threshold so, and
  * the more cautious of it and the prior's range counts. warn_risk: what the WARN rule risks (the interval read as
  * normal, its lower half-width interval_z standard errors). */
-static void speed_thresholds(const hm_alarm a, const hm_margin_estimate *g, const evidence *ev, hm_assessment *s) {
+static void speed_thresholds(const hm_alarm a, const hm_margin_estimate *g, const hm_evidence_interval *ev,
+                             hm_assessment *s) {
   const hm_alarm_config *c = &a->cfg;
   const hm_table_lookup_result *b = &s->boundaries;
   const double h = ev->precise ? b->hopf_speed_kmh - s->hopf_low_kmh : 0.0;
@@ -605,7 +482,7 @@ static void speed_thresholds(const hm_alarm a, const hm_margin_estimate *g, cons
   const double z = g && g->interval_z > 0.0 ? g->interval_z : 1.0;
   s->warn_from_kmh = warn_below_point(from, ev->precise ? s->hopf_low_kmh : from, c->warn_speed_margin_kmh, z);
   if (ev->usable && !ev->precise) {
-    const double lo_e = ev->free_counts ? fmin(g->hopf_model_low_kmh, a->free_low_kmh) : g->hopf_model_low_kmh;
+    const double lo_e = ev->free_counts ? fmin(g->hopf_model_low_kmh, a->ev.free_low_kmh) : g->hopf_model_low_kmh;
     s->warn_from_kmh = fmin(a->prior_hopf_low_kmh - c->warn_speed_margin_kmh,
                             warn_below_point(g->hopf_model_kmh, lo_e, c->warn_speed_margin_kmh, z));
   }
@@ -616,9 +493,22 @@ static void speed_thresholds(const hm_alarm a, const hm_margin_estimate *g, cons
 
 /* The conicity in use, the Hopf interval and the boundaries at the current speed; the table's status on failure. */
 static hm_status assess(hm_alarm a, const hm_estimate *e, const hm_margin_estimate *g, hm_assessment *s) {
-  const evidence ev = weigh_evidence(a, g, s->time_s);
-  double lambda, lambda_opt, lo, hi;
-  evidence_interval(a, g, &ev, &lambda, &lambda_opt, &lo, &hi, s);
+  const hm_alarm_config *c = &a->cfg;
+  /* a bogie's or car's model holds the frame: a frame sensor shows one of its modes (issue #28) */
+  const hm_evidence_config ec = {
+      c->use_conicity_estimate, c->conicity_max_se, c->conicity_fallback, c->conicity_prior_low,
+      a->prior_hopf_low_kmh, a->prior_hopf_high_kmh, hopf_kmh(&a->veh, a->model, c->conicity_fallback),
+      a->point == HM_POINT_WHEELSET || (a->model && hm_mode_model_kind(a->model) != HM_MODEL_WHEELSET)};
+  hm_evidence_interval ev;
+  hm_evidence_weigh(&a->ev, &ec, g, s->time_s, &ev);
+  const double lambda = ev.conicity, lambda_opt = ev.conicity_opt;
+  double lo = ev.low_kmh, hi = ev.high_kmh;
+  s->conicity_from_estimate = ev.precise;
+  s->conicity_from_prior = ev.from_prior;
+  s->model_interval_used = ev.usable;
+  s->conicity_se = ev.conicity_se;
+  s->model_mismatch = ev.mismatch;
+  s->hopf_free_used = ev.free_counts;
   s->conicity = lambda;
   hm_table_lookup_result b, bo;
   hm_status st = lookup(a, 0, lambda, e->speed_kmh, &b);
@@ -641,7 +531,7 @@ static hm_status assess(hm_alarm a, const hm_estimate *e, const hm_margin_estima
     if (st != HM_OK) return st;
     s->edge_used_m = bo.origin_stable && bo.has_edge ? bo.edge_amp_m : 0.0;
   }
-  a->precise = ev.precise;
+  a->ev.precise = ev.precise;
   return HM_OK;
 }
 
@@ -858,9 +748,9 @@ void hm_alarm_take_snapshot(const hm_alarm a, double now, hm_alarm_snapshot *out
                      (a->latched || isnan(a->hunted_mem_s) || now - a->hunted_mem_s <= a->memory_s);
   s.hunted_at_kmh = counts ? a->hunted_at_kmh : INFINITY;
   s.hunted_age_s = counts && !isnan(a->hunted_mem_s) ? fmax(now - a->hunted_mem_s, 0.0) : counts ? NAN : 0.0;
-  s.precise = a->precise;
-  s.se_ok = a->se_ok;
-  s.precise_lost = a->precise_lost;
+  s.precise = a->ev.precise;
+  s.se_ok = a->ev.se_ok;
+  s.precise_lost = a->ev.precise_lost;
   *out = s;
 }
 
@@ -896,8 +786,8 @@ hm_status hm_alarm_restore(hm_alarm a, double now, const hm_alarm_snapshot *s, c
   a->hunted_at_kmh = s->hunted_at_kmh;
   a->hunted_t_s = a->hunted_mem_s =
       s->hunted_at_kmh < INFINITY && !isnan(s->hunted_age_s) ? now - s->hunted_age_s : NAN;
-  a->precise = s->precise;
-  a->se_ok = s->se_ok;
-  a->precise_lost = s->precise_lost; /* (precise_since NAN: the wait counts from the first update) */
+  a->ev.precise = s->precise;
+  a->ev.se_ok = s->se_ok;
+  a->ev.precise_lost = s->precise_lost; /* (precise_since NAN: the wait counts from the first update) */
   return HM_OK;
 }
