@@ -238,7 +238,7 @@ static void restore_state(const char *path, hm_monitor mon, double t0, hm_state_
 }
 
 /* The vehicle model and its parameters from the options (a bogie's or car's kept in *cm); 0, or 1 with the reason on
- * stderr. */
+ * stderr. (A state file holds the model it was written for: another's is refused at --state-in, state.h.) */
 static int estimate_model(const cli_args *a, cli_model *cm, hm_vehicle *veh, hm_model_kind *kind, hm_car *params) {
   if (cli_model_kind(a, kind)) return 1;
   if (*kind == HM_MODEL_WHEELSET ? cli_vehicle(a, veh, NULL) : cli_vehicle_model(a, *kind, cm)) return 1;
@@ -249,11 +249,6 @@ static int estimate_model(const cli_args *a, cli_model *cm, hm_vehicle *veh, hm_
     *params = cm->params;
   }
   *veh = params->bogie.wheelset;
-  if (*kind != HM_MODEL_WHEELSET && (cli_has(a, "state-in") || cli_has(a, "state-out"))) {
-    fprintf(stderr, "hunting estimate: --state-in and --state-out take the wheelset model (not yet a %s)\n",
-            hm_model_kind_name(*kind));
-    return 1;
-  }
   return 0;
 }
 

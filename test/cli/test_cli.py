@@ -1116,7 +1116,8 @@ def test_estimate_on_a_bogie_model():
     `hunting tables --config`, refused by a wheelset monitor; before any window the Hopf interval is the prior's
     conicities (the configured 0.1358 -+ 0.03) through the bogie's own critical speeds (`hunting critical --config
     --conicity`, a separate path: eigenvalue bisection against the monitor's interpolated curve, to 0.05 km/h); a frame
-    accelerometer's windows read as the bogie's conicity; state files are refused for a bogie (not yet)."""
+    accelerometer's windows read as the bogie's conicity; its state file restored by its own monitor, refused by a
+    wheelset's."""
     bogie = os.path.join(SRC, "config", "bogie_default.yaml")
     with tempfile.TemporaryDirectory() as d:
         tbl, acc, spd = (os.path.join(d, n) for n in ("b.tbl", "a.csv", "s.csv"))
@@ -1140,9 +1141,22 @@ def test_estimate_on_a_bogie_model():
         assert last["conicity_estimate"] is not None and abs(last["conicity_estimate"] - 0.1358) < 0.02, last
         p = run("estimate", "--table", tbl, "--accel", acc, "--speed", spd, ok=False)
         assert p.returncode != 0 and "not for this vehicle" in p.stderr, p.stderr
-        p = run("estimate", "--config", bogie, "--table", tbl, "--accel", acc, "--speed", spd, "--state-out",
-                os.path.join(d, "st"), ok=False)
-        assert p.returncode != 0 and "take the wheelset model" in p.stderr, p.stderr
+        # a state file of the bogie's monitor: restored by the same monitor (its first line's estimate the one the
+        # writing run ended with, from the same windows), refused by a wheelset's
+        st = os.path.join(d, "st")
+        part = {n: os.path.join(d, n) for n in ("a1", "s1", "a2", "s2")}
+        split_recording(acc, 60.0, part["a1"], part["a2"])
+        split_recording(spd, 60.0, part["s1"], part["s2"])
+        written = lines(run("estimate", "--config", bogie, "--table", tbl, "--monitor", mon, "--accel", part["a1"],
+                            "--speed", part["s1"], "--every", "5", "--state-out", st).stdout)
+        again = lines(run("estimate", "--config", bogie, "--table", tbl, "--monitor", mon, "--accel", part["a2"],
+                          "--speed", part["s2"], "--every", "5", "--state-in", st).stdout)
+        n_win = written[-1]["windows_used"]
+        assert n_win > 0 and again[0]["restored"].startswith(f"restored, age 0 s, {n_win} window"), again[0]
+        close(again[0]["conicity_estimate"], written[-1]["conicity_estimate"], 1e-9, "the restored estimate")
+        p = run("estimate", "--accel", part["a2"], "--speed", part["s2"], "--every", "5", "--state-in", st,
+                "--table", shipped_table())
+        assert "not restored: " in p.stderr and "another vehicle" in p.stderr, p.stderr
 
 
 def main():
