@@ -466,20 +466,85 @@ static const cli_option sweep_opts[] = {
     VEHICLE_OPTIONS,
     {NULL, NULL, NULL}};
 
-static int cmd_sweep(const cli_args *a) {
-  hm_vehicle veh;
-  char name[HM_VEHICLE_NAME_MAX + 32];
-  double from = 0.05, to = 0.40, n_d = 15, omega;
-  if (cli_vehicle(a, &veh, name) || cli_number(a, "from", &from) || cli_number(a, "to", &to) ||
-      cli_number(a, "n", &n_d))
-    return 1;
-  if (!(from > 0.0) || !(to >= from) || !(n_d >= 1.0 && n_d <= 10000.0) || n_d != floor(n_d)) {
+/* The sweep's range: 0, or 1 with the reason on stderr. */
+static int sweep_range(const cli_args *a, double *from, double *to, int *n) {
+  double n_d = 15;
+  *from = 0.05, *to = 0.40;
+  if (cli_number(a, "from", from) || cli_number(a, "to", to) || cli_number(a, "n", &n_d)) return 1;
+  if (!(*from > 0.0) || !(*to >= *from) || !(n_d >= 1.0 && n_d <= 10000.0) || n_d != floor(n_d)) {
     fprintf(stderr, "hunting sweep: need 0 < --from <= --to and an integer --n in 1..10000\n");
     return 1;
   }
+  *n = (int)n_d;
+  return 0;
+}
+
+/* sweep on a bogie or car: at each conicity its linear critical speed by eigenvalues, the mode that goes first, and
+ * the speed with its frame (bogie) or carbody (car) held (JSON). */
+static int sweep_system(const cli_args *a, hm_model_kind kind) {
+  static cli_model cm;
+  double from, to;
+  int n;
+  if (cli_vehicle_model(a, kind, &cm) || sweep_range(a, &from, &to, &n)) return 1;
+  if (cli_has(a, "table")) {
+    fprintf(stderr, "hunting sweep: --table takes the wheelset (a %s's rows are JSON)\n", hm_model_kind_name(kind));
+    return 1;
+  }
+  hm_system_critical_options opt;
+  hm_system_critical_options_default(&opt);
+  json_writer w;
+  jw_init(&w, stdout);
+  jw_object(&w, NULL);
+  jw_string(&w, "model", hm_model_kind_name(kind));
+  jw_number(&w, "kx_mn_m", cm.wheelset.stiffness_long_n_m / 1e6);
+  jw_number(&w, "ky_mn_m", cm.wheelset.stiffness_lat_n_m / 1e6);
+  jw_array(&w, "rows");
+  for (int i = 0; i < n; ++i) {
+    const double lambda = n == 1 ? from : from + (to - from) * i / (n - 1);
+    hm_car car = cm.params;
+    if (hm_vehicle_set_conicity_at_zero(&car.bogie.wheelset, lambda) != HM_OK) {
+      fprintf(stderr, "hunting sweep: conicity %g: below the Gaussian terms' value at y = 0\n", lambda);
+      return 1;
+    }
+    static hm_bogie_model bm, bm_held;
+    static hm_car_model carm, carm_held;
+    hm_system sys, held;
+    hm_status st = kind == HM_MODEL_CAR ? hm_car_model_init(&carm, &car, 0, &sys)
+                                        : hm_bogie_model_init(&bm, &car.bogie, 0, &sys);
+    if (st == HM_OK)
+      st = kind == HM_MODEL_CAR ? hm_car_model_init(&carm_held, &car, 1, &held)
+                                : hm_bogie_model_init(&bm_held, &car.bogie, 1, &held);
+    if (st != HM_OK) return fail_status(hm_model_kind_name(kind), st);
+    double v = 0.0, v_held = 0.0;
+    hm_system_spectrum s;
+    st = hm_system_critical_speed(&sys, &opt, &v, &s);
+    if (st != HM_OK && st != HM_ENOCRIT) return fail_status("critical speed", st);
+    const hm_status st_held = hm_system_critical_speed(&held, &opt, &v_held, NULL);
+    jw_object(&w, NULL);
+    jw_number(&w, "conicity", lambda);
+    jw_number(&w, "v_crit_kmh", st == HM_OK ? hm_kmh_from_mps(v) : NAN); /* null: no critical speed */
+    if (st == HM_OK) jw_system_mode(&w, &sys, &s);
+    jw_number(&w, cm.held_name, st_held == HM_OK ? hm_kmh_from_mps(v_held) : NAN);
+    jw_end_object(&w);
+  }
+  jw_end_array(&w);
+  jw_end_object(&w);
+  jw_finish(&w);
+  return 0;
+}
+
+static int cmd_sweep(const cli_args *a) {
+  hm_vehicle veh;
+  hm_model_kind kind;
+  char name[HM_VEHICLE_NAME_MAX + 32];
+  double from, to, omega;
+  int n;
+  if (cli_model_kind(a, &kind)) return 1;
+  if (kind != HM_MODEL_WHEELSET) return sweep_system(a, kind);
+  if (cli_vehicle(a, &veh, name) || sweep_range(a, &from, &to, &n)) return 1;
   hm_status st = hm_linear_hopf_omega(&veh, &omega);
   if (st != HM_OK) return fail_status("Hopf frequency", st);
-  const int n = (int)n_d, table = cli_has(a, "table");
+  const int table = cli_has(a, "table");
   json_writer w;
   jw_init(&w, stdout);
   if (table) {
@@ -617,7 +682,9 @@ static const command commands[] = {
      "runs were made) or on the wall clock (--state-clock wall).",
      estimate_opts, cmd_estimate},
     {"sweep", "linear critical speed over a conicity range", "[--from L --to L --n COUNT] [--table]",
-     "Linear critical speed over a range of equivalent conicities (JSON, or a table with --table).", sweep_opts,
+     "Linear critical speed over a range of equivalent conicities (JSON, or a table with --table). With a bogie's or\n"
+     "car's --config, by its eigenvalues at each conicity: the mode that goes first and the speed with the frame\n"
+     "(bogie) or carbody (car) held beside it.", sweep_opts,
      cmd_sweep},
 };
 

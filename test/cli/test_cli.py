@@ -1111,6 +1111,22 @@ def test_bogie_and_car_simulate():
         assert p.returncode != 0 and "'roof' is not a place on a car" in p.stderr, p.stderr
 
 
+def test_sweep_on_a_bogie():
+    """`hunting sweep --config bogie.yaml` (issue #28): at each conicity the bogie's critical speed is `hunting critical
+    --config --conicity`'s (each row's conicity set on its own), and with the frame held it is the lone wheelset's
+    closed form (the wheelset's sweep, a second method: Hurwitz against eigenvalue bisection) to 1e-6 km/h."""
+    bogie = os.path.join(SRC, "config", "bogie_default.yaml")
+    rows = run_json("sweep", "--config", bogie, "--from", "0.1", "--to", "0.3", "--n", "3")["rows"]
+    wheelset = run_json("sweep", "--from", "0.1", "--to", "0.3", "--n", "3")["rows"]
+    assert len(rows) == 3 and len(wheelset) == 3, (rows, wheelset)
+    for r, w in zip(rows, wheelset):
+        one = run_json("critical", "--config", bogie, "--conicity", repr(r["conicity"]))
+        close(r["v_crit_kmh"], one["v_crit_kmh"], 1e-9, f"the bogie's critical speed at {r['conicity']}")
+        close(r["frame_held_v_crit_kmh"], w["v_crit_kmh"], 1e-6, f"frame held = wheelset at {r['conicity']}")
+    p = run("sweep", "--config", bogie, "--table", ok=False)
+    assert p.returncode != 0 and "--table takes the wheelset" in p.stderr, p.stderr
+
+
 def test_estimate_on_a_bogie_model():
     """`hunting estimate --config bogie.yaml`: the monitor on the bogie's model (issue #28). Its boundary table from
     `hunting tables --config`, refused by a wheelset monitor; before any window the Hopf interval is the prior's
