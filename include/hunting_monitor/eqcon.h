@@ -53,7 +53,8 @@ typedef struct {
 
 /* 0.46 m, 1.5 m, 1e-7. */
 void hm_eqcon_config_default(hm_eqcon_config *cfg);
-/* "field: reason" in why (HM_EDOMAIN): r0_m in (0, 5], contact_distance_m in (0, 5], tol in [1e-14, 1e-2]. */
+/* "field: reason (got value)" in why (HM_EDOMAIN): r0_m in [0.1, 1] (a wheel's rolling radius, as everywhere),
+ * contact_distance_m in (0, 5], tol in [1e-14, 1e-2]. */
 hm_status hm_eqcon_config_validate(const hm_eqcon_config *cfg, char *why, size_t why_len);
 
 /* A delta-r table: n >= 3 points, finite and within -+100 mm, y strictly increasing by at least 1 nm, a restoring

@@ -79,8 +79,8 @@ typedef struct {
 void hm_vehicle_default(hm_vehicle *veh);
 
 /*
- * Check every field: finite, masses, inertia, distances, radius, creep coefficients, l0/l1 and Kx > 0,
- * Ky >= 0, conicity constant >= 0, n_terms <= HM_CONICITY_MAX_TERMS, Gaussian widths > 0.
+ * Check every field: finite, masses, inertia, distances, creep coefficients, l0/l1 and Kx > 0, the rolling radius in
+ * [0.1, 1] m, Ky >= 0, conicity constant >= 0, n_terms <= HM_CONICITY_MAX_TERMS, Gaussian widths > 0.
  * On failure returns HM_EDOMAIN and writes "field: reason (got value)" into why (if why != NULL);
  * field names are those of the YAML config (e.g. "vehicle.mass_kg").
  */

@@ -58,8 +58,8 @@ typedef struct hm_sensor_sim_s *hm_sensor_sim;
 
 /* A run at t = 0 from state x0 (NULL: at rest). Validates the vehicle and every setting (speeds > 0, ramp >= 0,
  * scale >= 0, band within 0.2..1000 m, rates in (0, 1e6], noise >= 0, rtol > 0, atol >= 0, max step >= 0, x0
- * finite); HM_EDOMAIN with "field: reason (got value)" in why (may be NULL) for a setting, HM_EINVAL for a NULL
- * argument, HM_ENOMEM. Allocates the track (about 2 MB when scale > 0). */
+ * finite); HM_EDOMAIN with the reason in why (may be NULL: "field: reason (got value)" for a setting, a sentence for
+ * the profile or x0), HM_EINVAL for a NULL argument, HM_ENOMEM. Allocates the track (about 2 MB when scale > 0). */
 hm_status hm_sensor_sim_create(const hm_vehicle *veh, const hm_sensor_sim_config *cfg, const double x0[4],
                                hm_sensor_sim *out, char *why, size_t why_len);
 /* A run of the system sys (its model kept by the caller) with the accelerometer at point; x0 of sys->dim states or

@@ -18,7 +18,8 @@
  * Restored only when the record is whole and meant for this monitor, else refused with the reason (the monitor is
  * untouched and starts from the prior): the magic; the length it declares (shorter: truncated); the checksum; the
  * format version (only HM_STATE_VERSION is known: a newer one is refused); the hash of the vehicle and the settings
- * that give the windows their meaning (hm_state_hash); its age on the clock the caller names (below 0: written after
+ * that give the windows their meaning (hm_state_hash; for a bogie's or car's monitor also its model's parameters and
+ * the sensor's point, whose reading the windows are); its age on the clock the caller names (below 0: written after
  * now, another time line; memory_s or more: too old, the margin would have forgotten every window); every field in
  * its range (hm_margin_snapshot_validate, hm_alarm_snapshot_validate). The restored windows are aged by the record's
  * age, and those beyond memory_s are forgotten as usual.

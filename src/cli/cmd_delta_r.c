@@ -36,17 +36,20 @@ static int read_profile(const char *path, hm_profile *p) {
 }
 
 /* The contact settings from the options (mm, 1:N), checked by the core; 0, or 1 with the reason on stderr. *max_shift
- * and *step [mm] the shifts' range and step. */
-static int contact_settings(const cli_args *a, hm_contact_config *c, double *max_shift, double *step) {
+ * and *step [mm] the shifts' range and step; the gauge and flange-back distance [mm] as given. */
+static int contact_settings(const cli_args *a, hm_contact_config *c, double *max_shift, double *step, double *gauge_mm,
+                            double *fb_mm) {
   hm_contact_config_default(c);
   double r0 = 1e3 * c->r0_left_m, r0r = NAN, incl = 40.0, gauge = 1e3 * c->gauge_m, depth = 1e3 * c->gauge_depth_m,
          fb = 1e3 * c->flange_back_distance_m, mc = 1e3 * c->measuring_circle_m;
+  *gauge_mm = gauge, *fb_mm = fb;
   *max_shift = 8.0, *step = 0.1;
   if (cli_number(a, "r0-mm", &r0) || cli_number(a, "r0-right-mm", &r0r) || cli_number(a, "inclination", &incl) ||
       cli_number(a, "gauge-mm", &gauge) || cli_number(a, "gauge-depth-mm", &depth) ||
       cli_number(a, "flange-back-mm", &fb) || cli_number(a, "measuring-circle-mm", &mc) ||
       cli_number(a, "max-shift-mm", max_shift) || cli_number(a, "step-mm", step))
     return 1;
+  *gauge_mm = gauge, *fb_mm = fb; /* (as given, for the JSON) */
   if (!(incl == 0.0 || incl >= 10.0)) {
     fprintf(stderr, "hunting delta-r: --inclination must be 0 (upright) or N >= 10 for 1:N (got %g)\n", incl);
     return 1;
@@ -84,7 +87,8 @@ static int write_delta_r_csv(const char *out, const double *s, const hm_contact_
 }
 
 /* The JSON result: the settings and every column over the shifts; 0, or 1 out of memory. */
-static int write_delta_r_json(const hm_contact_config *c, const double *s, const hm_contact_point *p, size_t n) {
+static int write_delta_r_json(const hm_contact_config *c, double gauge_mm, double fb_mm, const double *s,
+                              const hm_contact_point *p, size_t n) {
   double *col = malloc(n * sizeof *col);
   if (!col) return cli_fail_status("delta-r", HM_ENOMEM);
   json_writer w;
@@ -92,8 +96,8 @@ static int write_delta_r_json(const hm_contact_config *c, const double *s, const
   jw_object(&w, NULL);
   jw_number(&w, "inclination", c->inclination);
   jw_bool(&w, "roll_included", c->include_roll);
-  jw_number(&w, "gauge_mm", 1e3 * c->gauge_m);
-  jw_number(&w, "flange_back_mm", 1e3 * c->flange_back_distance_m);
+  jw_number(&w, "gauge_mm", gauge_mm);
+  jw_number(&w, "flange_back_mm", fb_mm);
   jw_number(&w, "r0_left_mm", 1e3 * c->r0_left_m);
   jw_number(&w, "r0_right_mm", 1e3 * c->r0_right_m);
   for (size_t k = 0; k < n; ++k) col[k] = 1e3 * s[k];
@@ -123,8 +127,8 @@ int cmd_delta_r(const cli_args *a) {
     return 1;
   }
   hm_contact_config c;
-  double max_shift, step;
-  if (contact_settings(a, &c, &max_shift, &step)) return 1;
+  double max_shift, step, gauge_mm, fb_mm;
+  if (contact_settings(a, &c, &max_shift, &step, &gauge_mm, &fb_mm)) return 1;
   hm_profile wl = {0}, wr = {0}, rl = {0}, rr = {0};
   const char *wrp = cli_value(a, "wheel-right"), *rrp = cli_value(a, "rail-right");
   const size_t n = 2 * (size_t)floor(max_shift / step + 1e-9) + 1;
@@ -150,7 +154,7 @@ int cmd_delta_r(const cli_args *a) {
   }
   const char *out = cli_value(a, "out");
   if (out && write_delta_r_csv(out, s, p, n)) goto done;
-  rc = write_delta_r_json(&c, s, p, n);
+  rc = write_delta_r_json(&c, gauge_mm, fb_mm, s, p, n);
 done:
   free((void *)wl.y_m), free((void *)wr.y_m), free((void *)rl.y_m), free((void *)rr.y_m);
   free(s), free(p);

@@ -67,6 +67,9 @@ static void write_line(const hm_monitor_status *st, double t, const read_counts 
   const hm_report_field *f = hm_report_fields(&n);
   for (size_t i = 0; i < n; ++i) {
     const char *at = (const char *)&r + f[i].offset;
+    /* what the tool read, beside what the monitor counted (as the lines have always had them) */
+    if (strcmp(f[i].name, "accel_samples") == 0) jw_int(&w, "accel_rows", (long)rc->accel_rows);
+    if (strcmp(f[i].name, "speed_updates") == 0) jw_int(&w, "speed_rows", (long)rc->speed_rows);
     switch (f[i].kind) {
       case HM_REPORT_NUMBER: jw_number(&w, f[i].name, *(const double *)(const void *)at); break;
       case HM_REPORT_INT: jw_int(&w, f[i].name, *(const long *)(const void *)at); break;
@@ -75,8 +78,6 @@ static void write_line(const hm_monitor_status *st, double t, const read_counts 
       case HM_REPORT_TEXT: jw_string(&w, f[i].name, at); break;
     }
   }
-  jw_int(&w, "accel_rows", (long)rc->accel_rows);
-  jw_int(&w, "speed_rows", (long)rc->speed_rows);
   jw_int(&w, "speed_rows_unused", (long)rc->speed_rows_unused);
   jw_end_object(&w);
   jw_finish(&w);

@@ -490,6 +490,11 @@ static int sweep_system(const cli_args *a, hm_model_kind kind) {
     fprintf(stderr, "hunting sweep: --table takes the wheelset (a %s's rows are JSON)\n", hm_model_kind_name(kind));
     return 1;
   }
+  hm_vehicle first = cm.params.bogie.wheelset; /* (the conicities rise: the first is the one that can be refused) */
+  if (hm_vehicle_set_conicity_at_zero(&first, from) != HM_OK) {
+    fprintf(stderr, "hunting sweep: --from %g: below the Gaussian terms' value at y = 0\n", from);
+    return 1;
+  }
   hm_system_critical_options opt;
   hm_system_critical_options_default(&opt);
   json_writer w;

@@ -374,7 +374,8 @@ static void the_file_and_its_previous_one(void) {
 /* test_state --write-seed FILE also writes the record of restart_continues_the_assessment to FILE (the fuzz seed,
  * test/fuzz/seed_state.bin). */
 /* A bogie's or car's state is theirs alone (review of issue #28): a bogie monitor's record is refused by a wheelset
- * monitor with the same wheelsets, by a bogie with other yaw dampers, and restored by its own kind. */
+ * monitor with the same wheelsets, by a bogie with other yaw dampers, by the same bogie read at its frame (the same
+ * settings otherwise: its windows are another sensor's reading), and restored by its own kind. */
 static void a_models_state_is_its_own(void) {
   hm_car p;
   hm_car_default(&p);
@@ -384,18 +385,20 @@ static void a_models_state_is_its_own(void) {
   spec.amp_max_m = 0.004;
   hm_monitor_config cfg;
   hm_monitor_config_default(&cfg);
-  hm_monitor bogie[2] = {NULL, NULL}, wheelset = NULL;
+  hm_monitor bogie[3] = {NULL, NULL, NULL}, wheelset = NULL;
   char why[256] = "";
-  for (int k = 0; k < 2; ++k) {
+  for (int k = 0; k < 3; ++k) {
     hm_car q = p;
+    hm_monitor_config c = cfg;
     if (k == 1) q.bogie.yaw_damper_stiffness_n_m *= 0.8;
+    if (k == 2) c.estimator.measurement_point = HM_POINT_BOGIE_FRAME;
     hm_table t = NULL;
     HM_CHECK(hm_table_build_model(HM_MODEL_BOGIE, &q, &spec, NULL, NULL, &t) == HM_OK, "bogie table");
-    HM_CHECK(hm_monitor_create_model(&cfg, HM_MODEL_BOGIE, &q, t, NULL, NULL, &bogie[k], why, sizeof why) == HM_OK,
+    HM_CHECK(hm_monitor_create_model(&c, HM_MODEL_BOGIE, &q, t, NULL, NULL, &bogie[k], why, sizeof why) == HM_OK,
              "bogie monitor: %s", why);
   }
   wheelset = make_monitor(NULL, &p.bogie.wheelset);
-  if (!bogie[0] || !bogie[1] || !wheelset) goto done;
+  if (!bogie[0] || !bogie[1] || !bogie[2] || !wheelset) goto done;
   unsigned char rec[HM_STATE_MAX_BYTES];
   size_t n = 0;
   HM_CHECK(hm_state_save(bogie[0], 10.0, WALL0, rec, sizeof rec, &n) == HM_OK, "save");
@@ -403,12 +406,15 @@ static void a_models_state_is_its_own(void) {
                  "another vehicle or other settings", "a bogie's, to a wheelset");
   expect_refused(bogie[1], rec, n, 11.0, WALL0 + 1.0, HM_STATE_CLOCK_WALL, HM_EDOMAIN, HM_STATE_FOREIGN,
                  "another vehicle or other settings", "other yaw dampers");
+  expect_refused(bogie[2], rec, n, 11.0, WALL0 + 1.0, HM_STATE_CLOCK_WALL, HM_EDOMAIN, HM_STATE_FOREIGN,
+                 "another vehicle or other settings", "read at the frame");
   hm_state_outcome o;
   HM_CHECK(hm_state_restore(bogie[0], rec, n, 11.0, WALL0 + 1.0, HM_STATE_CLOCK_WALL, &o) == HM_OK, "its own: %s",
            o.text);
 done:
   hm_monitor_destroy(bogie[0]);
   hm_monitor_destroy(bogie[1]);
+  hm_monitor_destroy(bogie[2]);
   hm_monitor_destroy(wheelset);
 }
 

@@ -16,6 +16,7 @@ struct hm_alarm_s {
   hm_vehicle veh;
   hm_mode_model model;            /* a bogie's or car's (hm_alarm_set_model; borrowed), NULL: the wheelset's */
   double prior_hopf_low_kmh, prior_hopf_high_kmh; /* closed-form Hopf speeds at the prior's high and low ends */
+  double fallback_hopf_kmh;                       /* and at the fallback conicity (resolved with them) */
   hm_table table;
   hm_level level;
   hm_reason reason;
@@ -197,7 +198,7 @@ static double hopf_kmh(const hm_vehicle *veh, hm_mode_model model, double conici
 /* The configuration with the fallback and the prior resolved for the vehicle, and the prior's Hopf speeds; HM_EDOMAIN
  * (reason in why) for a prior that does not hold the fallback. */
 static hm_status resolve(const hm_alarm_config *cfg, const hm_vehicle *veh, hm_mode_model model, hm_alarm_config *out,
-                         double *hopf_low, double *hopf_high, char *why, size_t len) {
+                         double *hopf_low, double *hopf_high, double *hopf_fallback, char *why, size_t len) {
   hm_status st = hm_alarm_config_validate(cfg, why, len);
   if (st != HM_OK) return st;
   hm_alarm_config c = *cfg;
@@ -215,6 +216,7 @@ static hm_status resolve(const hm_alarm_config *cfg, const hm_vehicle *veh, hm_m
   *out = c;
   *hopf_low = hopf_kmh(veh, model, c.conicity_prior_high);
   *hopf_high = hopf_kmh(veh, model, c.conicity_prior_low);
+  *hopf_fallback = hopf_kmh(veh, model, c.conicity_fallback);
   return HM_OK;
 }
 
@@ -331,13 +333,14 @@ hm_status hm_alarm_set_config(hm_alarm a, const hm_alarm_config *cfg, const hm_v
                               size_t why_len) {
   if (!a || !cfg || !veh) return HM_EINVAL;
   hm_alarm_config c;
-  double lo, hi;
-  const hm_status st = resolve(cfg, veh, a->model, &c, &lo, &hi, why, why_len);
+  double lo, hi, at_fallback;
+  const hm_status st = resolve(cfg, veh, a->model, &c, &lo, &hi, &at_fallback, why, why_len);
   if (st != HM_OK) return st;
   a->cfg = c;
   a->veh = *veh;
   a->prior_hopf_low_kmh = lo;
   a->prior_hopf_high_kmh = hi;
+  a->fallback_hopf_kmh = at_fallback;
   a->cache[0].valid = a->cache[1].valid = 0; /* the conicity in use may change with the settings */
   return HM_OK;
 }
@@ -497,7 +500,7 @@ static hm_status assess(hm_alarm a, const hm_estimate *e, const hm_margin_estima
   /* a bogie's or car's model holds the frame: a frame sensor shows one of its modes (issue #28) */
   const hm_evidence_config ec = {
       c->use_conicity_estimate, c->conicity_max_se, c->conicity_fallback, c->conicity_prior_low,
-      a->prior_hopf_low_kmh, a->prior_hopf_high_kmh, hopf_kmh(&a->veh, a->model, c->conicity_fallback),
+      a->prior_hopf_low_kmh, a->prior_hopf_high_kmh, a->fallback_hopf_kmh,
       a->point == HM_POINT_WHEELSET || (a->model && hm_mode_model_kind(a->model) != HM_MODEL_WHEELSET)};
   hm_evidence_interval ev;
   hm_evidence_weigh(&a->ev, &ec, g, s->time_s, &ev);

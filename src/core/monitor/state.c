@@ -138,6 +138,7 @@ static uint64_t monitor_hash(const hm_monitor m) {
                         b->yaw_damper_half_distance_m, p.carbody_mass_kg, p.carbody_yaw_inertia_kg_m2,
                         p.half_bogie_distance_m};
     h = fnv_u64(h, (uint64_t)kind);
+    h = fnv_u64(h, (uint64_t)cfg.estimator.measurement_point); /* (the model's sensor: what its windows read) */
     for (size_t k = 0; k < sizeof v / sizeof v[0]; ++k)
       if (kind == HM_MODEL_CAR || k < 10) h = fnv_f64(h, v[k]);
   }

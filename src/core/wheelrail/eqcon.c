@@ -18,7 +18,7 @@ void hm_eqcon_config_default(hm_eqcon_config *cfg) {
 hm_status hm_eqcon_config_validate(const hm_eqcon_config *cfg, char *why, size_t why_len) {
   if (!cfg) return HM_EINVAL;
   const hm_field_check f[] = {{"r0_m", cfg->r0_m, HM_RULE_RANGE, HM_R0_MIN_M, HM_R0_MAX_M},
-                              {"contact_distance_m", cfg->contact_distance_m, HM_RULE_RANGE, 0.5, 2.5},
+                              {"contact_distance_m", cfg->contact_distance_m, HM_RULE_RANGE_OPEN, 0.0, 5.0},
                               {"tol", cfg->tol, HM_RULE_RANGE, 1e-14, 1e-2}};
   return hm_check_fields(f, HM_COUNT_OF(f), why, why_len);
 }
