@@ -170,6 +170,23 @@ int cli_model_kind(const cli_args *a, hm_model_kind *kind) {
   return 0;
 }
 
+hm_status cli_model_init(hm_model_kind kind, const hm_car *car, cli_model *out) {
+  out->kind = kind;
+  out->wheelset = car->bogie.wheelset;
+  out->params = *car;
+  hm_status st;
+  if (kind == HM_MODEL_CAR) {
+    st = hm_car_model_init(&out->car, &out->params, 0, &out->sys);
+    if (st == HM_OK) st = hm_car_model_init(&out->car_held, &out->params, 1, &out->held);
+    out->held_name = "carbody_held_v_crit_kmh";
+  } else {
+    st = hm_bogie_model_init(&out->bogie, &out->params.bogie, 0, &out->sys);
+    if (st == HM_OK) st = hm_bogie_model_init(&out->bogie_held, &out->params.bogie, 1, &out->held);
+    out->held_name = "frame_held_v_crit_kmh";
+  }
+  return st;
+}
+
 int cli_vehicle_model(const cli_args *a, hm_model_kind kind, cli_model *out) {
   hm_car car;
   char err[512];
@@ -195,18 +212,7 @@ int cli_vehicle_model(const cli_args *a, hm_model_kind kind, cli_model *out) {
     fprintf(stderr, "hunting: invalid %s: %s\n", hm_model_kind_name(kind), err);
     return 1;
   }
-  out->kind = kind;
-  out->wheelset = *w;
-  out->params = car;
-  if (kind == HM_MODEL_CAR) {
-    st = hm_car_model_init(&out->car, &car, 0, &out->sys);
-    if (st == HM_OK) st = hm_car_model_init(&out->car_held, &car, 1, &out->held);
-    out->held_name = "carbody_held_v_crit_kmh";
-  } else {
-    st = hm_bogie_model_init(&out->bogie, &car.bogie, 0, &out->sys);
-    if (st == HM_OK) st = hm_bogie_model_init(&out->bogie_held, &car.bogie, 1, &out->held);
-    out->held_name = "frame_held_v_crit_kmh";
-  }
+  st = cli_model_init(kind, &car, out);
   if (st != HM_OK) {
     fprintf(stderr, "hunting: %s: %s\n", hm_model_kind_name(kind), hm_status_str(st));
     return 1;

@@ -57,6 +57,8 @@ typedef struct {
   const char *held_name; /* the JSON key of the held variant's critical speed */
 } cli_model;
 int cli_vehicle_model(const cli_args *a, hm_model_kind kind, cli_model *out);
+/* out's model of kind from car's parameters (its systems point into out: keep out in place); the models' status. */
+hm_status cli_model_init(hm_model_kind kind, const hm_car *car, cli_model *out);
 
 void cli_print_help(FILE *f, const char *command, const char *usage, const char *summary, const cli_option *opts);
 

@@ -42,7 +42,6 @@ static int contact_settings(const cli_args *a, hm_contact_config *c, double *max
   hm_contact_config_default(c);
   double r0 = 1e3 * c->r0_left_m, r0r = NAN, incl = 40.0, gauge = 1e3 * c->gauge_m, depth = 1e3 * c->gauge_depth_m,
          fb = 1e3 * c->flange_back_distance_m, mc = 1e3 * c->measuring_circle_m;
-  *gauge_mm = gauge, *fb_mm = fb;
   *max_shift = 8.0, *step = 0.1;
   if (cli_number(a, "r0-mm", &r0) || cli_number(a, "r0-right-mm", &r0r) || cli_number(a, "inclination", &incl) ||
       cli_number(a, "gauge-mm", &gauge) || cli_number(a, "gauge-depth-mm", &depth) ||

@@ -511,24 +511,18 @@ static int sweep_system(const cli_args *a, hm_model_kind kind) {
       fprintf(stderr, "hunting sweep: conicity %g: below the Gaussian terms' value at y = 0\n", lambda);
       return 1;
     }
-    static hm_bogie_model bm, bm_held;
-    static hm_car_model carm, carm_held;
-    hm_system sys, held;
-    hm_status st = kind == HM_MODEL_CAR ? hm_car_model_init(&carm, &car, 0, &sys)
-                                        : hm_bogie_model_init(&bm, &car.bogie, 0, &sys);
-    if (st == HM_OK)
-      st = kind == HM_MODEL_CAR ? hm_car_model_init(&carm_held, &car, 1, &held)
-                                : hm_bogie_model_init(&bm_held, &car.bogie, 1, &held);
+    static cli_model row; /* (its systems point into it) */
+    hm_status st = cli_model_init(kind, &car, &row);
     if (st != HM_OK) return fail_status(hm_model_kind_name(kind), st);
     double v = 0.0, v_held = 0.0;
     hm_system_spectrum s;
-    st = hm_system_critical_speed(&sys, &opt, &v, &s);
+    st = hm_system_critical_speed(&row.sys, &opt, &v, &s);
     if (st != HM_OK && st != HM_ENOCRIT) return fail_status("critical speed", st);
-    const hm_status st_held = hm_system_critical_speed(&held, &opt, &v_held, NULL);
+    const hm_status st_held = hm_system_critical_speed(&row.held, &opt, &v_held, NULL);
     jw_object(&w, NULL);
     jw_number(&w, "conicity", lambda);
     jw_number(&w, "v_crit_kmh", st == HM_OK ? hm_kmh_from_mps(v) : NAN); /* null: no critical speed */
-    if (st == HM_OK) jw_system_mode(&w, &sys, &s);
+    if (st == HM_OK) jw_system_mode(&w, &row.sys, &s);
     jw_number(&w, cm.held_name, st_held == HM_OK ? hm_kmh_from_mps(v_held) : NAN);
     jw_end_object(&w);
   }

@@ -51,19 +51,18 @@ static inline int hm_field_ok(const hm_field_check *f) {
 static inline hm_status hm_check_fields(const hm_field_check *f, size_t n, char *why, size_t why_len) {
   for (size_t i = 0; i < n; ++i) {
     if (hm_field_ok(&f[i])) continue;
-    char reason[80];
-    switch (f[i].rule) {
-      case HM_RULE_POSITIVE: snprintf(reason, sizeof reason, "must be > 0"); break;
-      case HM_RULE_NONNEG: snprintf(reason, sizeof reason, "must be >= 0"); break;
-      case HM_RULE_RANGE: snprintf(reason, sizeof reason, "must be in [%g, %g]", f[i].lo, f[i].hi); break;
-      case HM_RULE_RANGE_OPEN: snprintf(reason, sizeof reason, "must be in (%g, %g]", f[i].lo, f[i].hi); break;
-      case HM_RULE_FLAG: snprintf(reason, sizeof reason, "must be 0 or 1"); break;
-      case HM_RULE_OPEN: snprintf(reason, sizeof reason, "must be in (%g, %g)", f[i].lo, f[i].hi); break;
-      default: snprintf(reason, sizeof reason, "must be a finite number"); break;
-    }
-    if (!isfinite(f[i].value) && f[i].rule != HM_RULE_RANGE && f[i].rule != HM_RULE_RANGE_OPEN &&
-        f[i].rule != HM_RULE_OPEN)
-      snprintf(reason, sizeof reason, "must be a finite number");
+    /* a range states its ends whatever the value; any other rule, a value that is not finite, says so */
+    const int range = f[i].rule == HM_RULE_RANGE || f[i].rule == HM_RULE_RANGE_OPEN || f[i].rule == HM_RULE_OPEN;
+    char reason[80] = "must be a finite number";
+    if (range || isfinite(f[i].value)) switch (f[i].rule) {
+        case HM_RULE_POSITIVE: snprintf(reason, sizeof reason, "must be > 0"); break;
+        case HM_RULE_NONNEG: snprintf(reason, sizeof reason, "must be >= 0"); break;
+        case HM_RULE_RANGE: snprintf(reason, sizeof reason, "must be in [%g, %g]", f[i].lo, f[i].hi); break;
+        case HM_RULE_RANGE_OPEN: snprintf(reason, sizeof reason, "must be in (%g, %g]", f[i].lo, f[i].hi); break;
+        case HM_RULE_OPEN: snprintf(reason, sizeof reason, "must be in (%g, %g)", f[i].lo, f[i].hi); break;
+        case HM_RULE_FLAG: snprintf(reason, sizeof reason, "must be 0 or 1"); break;
+        case HM_RULE_FINITE: break;
+      }
     return hm_reject(why, why_len, f[i].field, reason, f[i].value);
   }
   return HM_OK;

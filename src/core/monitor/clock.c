@@ -3,6 +3,7 @@
 
 #include <math.h>
 #include <stdio.h>
+
 #include "validate.h"
 
 void hm_clock_config_default(hm_clock_config *cfg) {

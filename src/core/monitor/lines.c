@@ -4,13 +4,12 @@
 #include "hunting_monitor/model.h"
 
 #include "select.h"
+#include "validate.h"
 
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-#include "validate.h"
-
 
 enum { MAX_CANDIDATES = 32, MAX_DIVISOR = 12 };
 

@@ -7,6 +7,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+
 #include "validate.h"
 
 /* Speed statistics per fit interval, so that the steady part of the window and its speed are known. */

@@ -5,6 +5,7 @@
 #include <stdarg.h>
 #include <stdio.h>
 #include <string.h>
+
 #include "validate.h"
 
 static const unsigned char magic[8] = {'H', 'M', 'S', 'T', 'A', 'T', 'E', '\0'};

@@ -6,6 +6,7 @@
 #include <math.h>
 #include <stdio.h>
 #include <string.h>
+
 #include "validate.h"
 
 void hm_track_lines_config_default(hm_track_lines_config *cfg) {

@@ -3,6 +3,7 @@
 
 #include <math.h>
 #include <stdio.h>
+
 #include "validate.h"
 
 void hm_contact_config_default(hm_contact_config *cfg) {

@@ -4,6 +4,7 @@
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
+
 #include "validate.h"
 
 #define PI 3.14159265358979323846
