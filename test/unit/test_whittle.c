@@ -111,7 +111,26 @@ static void a_pair_holds_its_power(void) {
   }
 }
 
+/* The pass's own e^x (whittle.h) against the C library's long-double expl over [-708, 708]: evenly spaced points,
+ * the ends, and points where r, the reduced argument, is at its ends (x = (k + 1/2) ln 2); at most 2 ulp of the
+ * double nearest e^x, and exactly 1 at 0. */
+static void its_exp_is_exp(void) {
+  double worst = 0.0, at = 0.0;
+  for (long i = 0; i <= 2000000; ++i) {
+    const double x = i < 1000000 ? -708.0 + 1416.0 * (double)i / 1e6 : (double)(i - 1000000 - 1021) * 0.5 * log(2.0);
+    if (!(x >= -708.0 && x <= 708.0)) continue;
+    const long double ref = expl((long double)x);
+    const double ulp = nextafter((double)ref, INFINITY) - (double)ref;
+    const double err = fabs((double)((long double)hm_whittle_exp(x) - ref)) / ulp;
+    if (err > worst) worst = err, at = x;
+  }
+  printf("  e^x over [-708, 708]: at most %.2f ulp (at x = %.6g)\n", worst, at);
+  HM_CHECK(worst <= 2.0, "%.2f ulp at %g", worst, at);
+  HM_CHECK(hm_whittle_exp(0.0) == 1.0, "e^0 = %.17g", hm_whittle_exp(0.0));
+}
+
 int main(void) {
+  HM_RUN(its_exp_is_exp);
   HM_RUN(fit_returns_the_spectrum_it_was_given);
   HM_RUN(a_line_is_sigma_zero);
   HM_RUN(a_pair_holds_its_power);

@@ -19,75 +19,102 @@ static pair_k pair_constants(double sg, double w0, double T) {
 /* One pair's term P (whittle.h) and the derivatives of ln P with respect to sigma (= -a) and w0: the Lorentzian of
  * width a_e over the pair's two poles, times a_e (the power form). */
 static inline double pair_term(const pair_k *c, double w, double *dl_sg, double *dl_w0) {
-  const double ae = c->ae, dl = w - c->w0, sm = w + c->w0;
-  const double iqd = 1.0 / (ae * ae + dl * dl), iqs = 1.0 / (ae * ae + sm * sm);
+  const double ae = c->ae, dl = w - c->w0, sm = w + c->w0, qd = ae * ae + dl * dl, qs = ae * ae + sm * sm;
+  const double iq = 1.0 / (qd * qs), iqd = qs * iq, iqs = qd * iq; /* (one division) */
   *dl_sg = -(c->inv_ae - 2.0 * ae * (iqd + iqs));
   *dl_w0 = 2.0 * (dl * iqd - sm * iqs);
   return ae * iqd * iqs;
 }
 
-/* S at one bin (noise = exp(th[ln N]), rho = exp(th[ln rho]) passed in: one exp per pass), its gradient of ln S in
- * grad if not NULL. */
-static inline double spectrum(const double *th, unsigned poles, const pair_k *c1, const pair_k *c2, double noise,
-                              double rho, double w, double u, double *grad) {
-  double a1, b1;
-  const double p1 = pair_term(c1, w, &a1, &b1);
-  const double b = exp(th[HM_W_C0] + u * (th[HM_W_C1] + u * (th[HM_W_C2] + u * th[HM_W_C3])));
-  const double m1 = b * p1;
-  double m2 = 0.0, a2 = 0.0, b2 = 0.0;
-  if (poles == 2) m2 = b * rho * pair_term(c2, w, &a2, &b2);
-  const double s = m1 + m2 + noise;
-  if (grad) {
-    const double is = 1.0 / s, r1 = m1 * is, r2 = m2 * is, rb = r1 + r2, u2 = u * u;
-    grad[HM_W_SIGMA] = r1 * a1;
-    grad[HM_W_W0] = r1 * b1;
-    grad[HM_W_C0] = rb;
-    grad[HM_W_C1] = rb * u;
-    grad[HM_W_C2] = rb * u2;
-    grad[HM_W_C3] = rb * u2 * u;
-    grad[HM_W_LN] = noise * is;
-    if (poles == 2) {
-      grad[HM_W_SIGMA2] = r2 * a2;
-      grad[HM_W_W02] = r2 * b2;
-      grad[HM_W_LNRHO] = r2;
-    }
-  }
-  return s;
+/* S at one bin given B there (noise = exp(th[ln N]), rho = exp(th[ln rho]): once a pass); evaluate_n writes its
+ * gradient's columns itself. */
+static inline double spectrum_b(unsigned poles, const pair_k *c1, const pair_k *c2, double noise, double rho,
+                                double b, double w) {
+  double a1, b1, a2, b2;
+  return b * (pair_term(c1, w, &a1, &b1) + (poles == 2 ? rho * pair_term(c2, w, &a2, &b2) : 0.0)) + noise;
 }
 
+static inline double background(const double *th, double u) {
+  return th[HM_W_C0] + u * (th[HM_W_C1] + u * (th[HM_W_C2] + u * th[HM_W_C3]));
+}
+
+enum { BLOCK = 64 }; /* bins a block: its columns of J (NPM x BLOCK doubles, 5 kB) stay in the cache */
+
 /* The objective at th and, when f is not NULL, the Fisher information J'J in f and the score J'(I/S - 1) in g: one
- * pass, one exp a bin and one log a pass (the sum of ln S as the logarithm of a product renormalised every four bins
- * by frexp: the same to rounding as a log a bin, a fifth of the pass's time). poles is a constant in each caller
- * below, so that the accumulation's loops unroll. */
+ * pass over blocks of bins, each in loops the compiler vectorises (B's exponent, B, S and J's columns, then J'J and
+ * J'(I/S - 1) as dot products of the columns), and one log a pass (the sum of ln S as the logarithm of a product
+ * renormalised every four bins by frexp: the same to rounding as a log a bin, a fifth of the pass's time). poles is
+ * a constant in each caller below, so that the loops unroll. */
 static inline double evaluate_n(const hm_whittle_data *d, const unsigned poles, const double *th, double f[NPM][NPM],
                                 double *g) {
   const unsigned np = hm_whittle_np(poles);
   const double noise = exp(th[HM_W_LN]), rho = poles == 2 ? exp(th[HM_W_LNRHO]) : 0.0;
   const pair_k c1 = pair_constants(th[HM_W_SIGMA], th[HM_W_W0], d->window_s);
   const pair_k c2 = poles == 2 ? pair_constants(th[HM_W_SIGMA2], th[HM_W_W02], d->window_s) : c1;
+  const double cb[4] = {th[HM_W_C0], th[HM_W_C1], th[HM_W_C2], th[HM_W_C3]};
   double l_rest = 0.0, prod = 1.0;
   long exp2_sum = 0;
   if (f) {
     memset(f, 0, sizeof(double) * NPM * NPM);
     memset(g, 0, sizeof(double) * NPM);
   }
-  for (size_t k = 0; k < d->n; ++k) {
-    double j[NPM];
-    const double sk = spectrum(th, poles, &c1, &c2, noise, rho, d->w[k], d->u[k], f ? j : NULL), q = d->pgram[k] / sk;
-    l_rest += q;
-    if (sk >= 1e-70 && sk <= 1e70) /* (four such stay within a double's range; any other, NaN too, taken alone) */
-      prod *= sk;
+  for (size_t k0 = 0; k0 < d->n; k0 += BLOCK) {
+    const size_t nk = d->n - k0 < BLOCK ? d->n - k0 : BLOCK;
+    const double *w = d->w + k0, *u = d->u + k0, *pg = d->pgram + k0;
+    double b[BLOCK], s[BLOCK], q[BLOCK], col[NPM][BLOCK]; /* B, S, I / S and J's columns (d ln S / d theta) */
+    long wide = 0;
+    for (size_t i = 0; i < nk; ++i) b[i] = cb[0] + u[i] * (cb[1] + u[i] * (cb[2] + u[i] * cb[3]));
+    for (size_t i = 0; i < nk; ++i) wide |= (long)((b[i] < -708.0) | (b[i] > 708.0) | (b[i] != b[i]));
+    if (!wide)
+      for (size_t i = 0; i < nk; ++i) b[i] = hm_whittle_exp(b[i]);
+    else /* (a trial step far out, or NaN: libm's exp) */
+      for (size_t i = 0; i < nk; ++i) b[i] = exp(b[i]);
+    if (f)
+      for (size_t i = 0; i < nk; ++i) {
+        double a1, b1, a2 = 0.0, b2 = 0.0;
+        const double m1 = b[i] * pair_term(&c1, w[i], &a1, &b1);
+        const double m2 = poles == 2 ? b[i] * rho * pair_term(&c2, w[i], &a2, &b2) : 0.0;
+        const double sk = m1 + m2 + noise, is = 1.0 / sk, r1 = m1 * is, r2 = m2 * is, rb = r1 + r2, uk = u[i];
+        s[i] = sk;
+        col[HM_W_SIGMA][i] = r1 * a1;
+        col[HM_W_W0][i] = r1 * b1;
+        col[HM_W_C0][i] = rb;
+        col[HM_W_C1][i] = rb * uk;
+        col[HM_W_C2][i] = rb * uk * uk;
+        col[HM_W_C3][i] = rb * uk * uk * uk;
+        col[HM_W_LN][i] = noise * is;
+        if (poles == 2) {
+          col[HM_W_SIGMA2][i] = r2 * a2;
+          col[HM_W_W02][i] = r2 * b2;
+          col[HM_W_LNRHO][i] = r2;
+        }
+      }
     else
-      l_rest += log(sk);
-    if ((k & 3u) == 3u) {
-      int ex;
-      prod = frexp(prod, &ex);
-      exp2_sum += ex;
+      for (size_t i = 0; i < nk; ++i) s[i] = spectrum_b(poles, &c1, &c2, noise, rho, b[i], w[i]);
+    for (size_t i = 0; i < nk; ++i) q[i] = pg[i] / s[i];
+    for (size_t i = 0; i < nk; ++i) {
+      const double sk = s[i];
+      l_rest += q[i];
+      if (sk >= 1e-70 && sk <= 1e70) /* (four such stay within a double's range; any other, NaN too, taken alone) */
+        prod *= sk;
+      else
+        l_rest += log(sk);
+      if (((k0 + i) & 3u) == 3u) {
+        int ex;
+        prod = frexp(prod, &ex);
+        exp2_sum += ex;
+      }
     }
     if (!f) continue;
     for (unsigned a = 0; a < np; ++a) {
-      g[a] += j[a] * (q - 1.0);
-      for (unsigned c = 0; c <= a; ++c) f[a][c] += j[a] * j[c];
+      double ga = 0.0;
+      for (size_t i = 0; i < nk; ++i) ga += col[a][i] * (q[i] - 1.0);
+      g[a] += ga;
+      for (unsigned c = 0; c <= a; ++c) {
+        double fac = 0.0;
+        for (size_t i = 0; i < nk; ++i) fac += col[a][i] * col[c][i];
+        f[a][c] += fac;
+      }
     }
   }
   if (f)
@@ -103,7 +130,8 @@ static double evaluate(const hm_whittle_data *d, unsigned poles, const double *t
 double hm_whittle_spectrum(const double *th, unsigned poles, double window_s, double w, double u) {
   const pair_k c1 = pair_constants(th[HM_W_SIGMA], th[HM_W_W0], window_s);
   const pair_k c2 = poles == 2 ? pair_constants(th[HM_W_SIGMA2], th[HM_W_W02], window_s) : c1;
-  return spectrum(th, poles, &c1, &c2, exp(th[HM_W_LN]), poles == 2 ? exp(th[HM_W_LNRHO]) : 0.0, w, u, NULL);
+  return spectrum_b(poles, &c1, &c2, exp(th[HM_W_LN]), poles == 2 ? exp(th[HM_W_LNRHO]) : 0.0,
+                    exp(background(th, u)), w);
 }
 
 double hm_whittle_objective(const hm_whittle_data *d, unsigned poles, const double *theta) {
