@@ -29,9 +29,9 @@
  *    between two samples changed: a speed held between its updates costs one sine and cosine per update).
  * The caller decides when it is worth it (modal.c: where the window's speed trend moved a line at the band's top
  * by more than two bins).
- * No allocation after create; cost per call: two real FFTs of nfft, the interpolation (n), the line search, for each
- * candidate (at most HM_ORDER_LINES_MAX) a median over +-0.5 Hz and two harmonic F fits, and n complex rotations per
- * track line.
+ * No allocation after create; cost per call: two real FFTs of nfft (one with the DFT in time given), the
+ * interpolation (n), the line search, for each candidate (at most HM_ORDER_LINES_MAX) a median over +-0.5 Hz and two
+ * harmonic F fits, and n complex rotations per track line.
  */
 #ifndef HUNTING_MONITOR_ORDER_LINES_H
 #define HUNTING_MONITOR_ORDER_LINES_H
@@ -94,6 +94,13 @@ void hm_order_lines_destroy(hm_order_lines o);
  */
 hm_status hm_order_lines_clean(hm_order_lines o, double *x, const double *v_mps, size_t n, double fs_hz, size_t nfft,
                                double f_lo_hz, double f_hi_hz, hm_order_lines_result *out);
+
+/* The same with the window's DFT in time given: re[0..nfft/2], im[0..nfft/2] and pw = re^2 + im^2 of x less its mean,
+ * zero-padded to nfft, as hm_fft_real gives it (a caller that has the window's periodogram saves an FFT; modal.c).
+ * HM_EINVAL also for a NULL re, im or pw. */
+hm_status hm_order_lines_clean_dft(hm_order_lines o, double *x, const double *v_mps, size_t n, double fs_hz,
+                                   size_t nfft, double f_lo_hz, double f_hi_hz, const double *re, const double *im,
+                                   const double *pw, hm_order_lines_result *out);
 
 #ifdef __cplusplus
 }

@@ -132,6 +132,43 @@ static void comb_and_lone_line(void) {
   hm_order_lines_destroy(o);
 }
 
+/* With the window's DFT in time given (hm_order_lines_clean_dft; here a direct DFT, the sum over the samples at each
+ * bin, not the FFT) the same lines are taken as when it computes it, and x is the same to rounding: the comb and
+ * lone line above. */
+static void dft_given_is_the_same(void) {
+  hm_order_lines o = make();
+  static double x[N], y[N], v[N], re[NFFT / 2 + 1], im[NFFT / 2 + 1], pw[NFFT / 2 + 1];
+  const double L = 60.0, Ls = 6.45, v0 = 120.0, acc = 6.0 / (N / FS);
+  unsigned long long st = 5;
+  double mean = 0.0;
+  for (int i = 0; i < N; ++i) {
+    const double t = i / FS, s = v0 * t + 0.5 * acc * t * t, p = fmod(s, L);
+    v[i] = v0 + acc * t;
+    x[i] = y[i] = (p < 1.0 ? 0.8 * (1.0 - cos(2.0 * HM_PI * p)) : 0.0) + 0.4 * cos(2.0 * HM_PI * s / Ls) +
+                  gauss(&st, 0.05);
+    mean += x[i] / N;
+  }
+  for (int k = 0; k <= NFFT / 2; ++k) {
+    double a = 0.0, b = 0.0;
+    for (int i = 0; i < N; ++i) {
+      const double ph = -2.0 * HM_PI * (double)((long)k * i % NFFT) / NFFT;
+      a += (x[i] - mean) * cos(ph), b += (x[i] - mean) * sin(ph);
+    }
+    re[k] = a, im[k] = b, pw[k] = a * a + b * b;
+  }
+  hm_order_lines_result r, q;
+  HM_CHECK(hm_order_lines_clean(o, x, v, N, FS, NFFT, 2.5, 30.0, &r) == HM_OK, "clean");
+  HM_CHECK(hm_order_lines_clean_dft(o, y, v, N, FS, NFFT, 2.5, 30.0, re, im, pw, &q) == HM_OK, "clean, DFT given");
+  HM_CHECK(r.n >= 2 && q.n == r.n, "lines taken: %u and %u", r.n, q.n);
+  for (unsigned k = 0; k < r.n && k < q.n; ++k)
+    HM_CHECK_REL(q.wavelength_m[k], r.wavelength_m[k], 1e-9, "a line's wavelength");
+  double worst = 0.0;
+  for (int i = 0; i < N; ++i) worst = fmax(worst, fabs(x[i] - y[i]));
+  HM_CHECK(worst < 1e-9, "x differs by %g", worst);
+  HM_CHECK(hm_order_lines_clean_dft(o, y, v, N, FS, NFFT, 2.5, 30.0, re, NULL, pw, &q) == HM_EINVAL, "NULL im");
+  hm_order_lines_destroy(o);
+}
+
 static void bad_input(void) {
   hm_order_lines_config c;
   hm_order_lines_config_default(&c);
@@ -173,6 +210,7 @@ int main(void) {
   HM_RUN(steady_takes_nothing);
   HM_RUN(joints_comb);
   HM_RUN(comb_and_lone_line);
+  HM_RUN(dft_given_is_the_same);
   HM_RUN(bad_input);
   HM_TEST_EXIT();
 }

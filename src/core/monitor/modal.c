@@ -731,10 +731,11 @@ static int halves_tracking(hm_modal m, size_t n, const window_geometry *g, const
   return 1;
 }
 
-/* The last window_s (at least the n to fit) copied oldest first into m->x, with its speeds; where the newest n's
- * speed trend moved a line at band_high_hz by more than two bins, the track lines taken out of them in distance
- * (order_lines.h), reported in r. (Only the newest n: the halves' order tracking over window_s reads the older part
- * as it came.) */
+/* The last window_s (at least the n to fit) copied oldest first into m->x, with its speeds, and the newest n's
+ * periodogram (periodogram()); where their speed trend moved a line at band_high_hz by more than two bins, the track
+ * lines taken out of them in distance (order_lines.h, from that periodogram), reported in r, and the periodogram
+ * computed again if any was. (Only the newest n: the halves' order tracking over window_s reads the older part as
+ * it came.) */
 static void take_window(hm_modal m, size_t n, hm_mode_estimate *r) {
   const size_t len = (size_t)fmax((double)n, fmin((double)m->n_in, floor(m->cfg.window_s * m->fd + 1e-6)));
   const size_t oldest = (m->head + m->n_win - len) % m->n_win;
@@ -745,6 +746,7 @@ static void take_window(hm_modal m, size_t n, hm_mode_estimate *r) {
   m->x_len = len;
   m->n_order = 0;
   m->order_comb_hz = 0.0;
+  periodogram(m, n);
   double *x = m->x + (len - n);
   const double *v = m->xv + (len - n);
   /* the speed's least-squares trend over the window (a speed signal's noise of 0.3 km/h moves its range by 2 km/h
@@ -758,9 +760,12 @@ static void take_window(hm_modal m, size_t n, hm_mode_estimate *r) {
   const double T = nn / m->fd, trend_rel = fabs(slope) * (nn - 1.0) / (sum / nn);
   if (!(m->cfg.reject_lines && m->cfg.band_high_hz * trend_rel > 2.0 / T)) return;
   hm_order_lines_result o;
-  if (hm_order_lines_clean(m->order, x, v, n, m->fd, m->nfft, 2.5, 0.3 * m->fd, &o) != HM_OK) return;
+  if (hm_order_lines_clean_dft(m->order, x, v, n, m->fd, m->nfft, 2.5, 0.3 * m->fd, m->re, m->im, m->power, &o) !=
+      HM_OK)
+    return;
   m->order_comb_hz = o.comb_fundamental_hz;
   if (o.n == 0) return;
+  periodogram(m, n); /* (of the samples without the lines) */
   unsigned best = 0;
   for (unsigned q = 1; q < o.n; ++q)
     if (o.amp_mps2[q] > o.amp_mps2[best]) best = q;
@@ -825,7 +830,6 @@ hm_status hm_modal_fit(hm_modal m, double max_window_s, double speed_spread_rel,
     return HM_OK;
   }
   take_window(m, n, &r);
-  periodogram(m, n);
   const window_geometry g = geometry(m, n, speed_spread_rel);
   hm_lines_result lr;
   find_comb(m, n, g.df, g.T, g.spread_rel, &lr, &r);

@@ -14,9 +14,9 @@
 struct hm_order_lines_s {
   hm_order_lines_config cfg;
   size_t max_n, nfft_max;
-  double *s;                    /* each sample's distance from the first [m] */
+  double *s;                    /* each sample's distance from the first [m]; then the resampled window's copy */
   double *dre, *dim, *dpow;     /* the distance-resampled window's DFT and power */
-  double *tre, *tim, *tpow;     /* the time window's */
+  double *tre, *tim, *tpow;     /* the time window's (hm_order_lines_clean's) */
   double *cosw, *sinw;          /* twiddles (nfft_max / 2) */
   double *scratch;              /* a median's selection */
   double halfwidth_hz;          /* the median's half-width (lines.h's background_halfwidth_hz) */
@@ -141,13 +141,42 @@ static double ratio_at(const hm_order_lines o, const double *pw, size_t nb, doub
   return bg > 0.0 ? pw[k] / bg : INFINITY;
 }
 
-hm_status hm_order_lines_clean(hm_order_lines o, double *x, const double *v, size_t n, double fs, size_t nfft,
-                               double f_lo, double f_hi, hm_order_lines_result *out) {
+/* hm_order_lines_clean's arguments' checks (order_lines.h). */
+static hm_status check(const hm_order_lines o, const double *x, const double *v, size_t n, double fs, size_t nfft,
+                       double f_lo, double f_hi, const void *out) {
   if (!o || !x || !v || !out || n < 8 || n > o->max_n || nfft < n || nfft > o->nfft_max ||
       (nfft & (nfft - 1)) != 0 || !(fs > 0.0) || !(f_lo > 0.0) || !(f_hi > f_lo))
     return HM_EINVAL;
   for (size_t i = 0; i < n; ++i)
     if (!(isfinite(v[i]) && v[i] > 0.0)) return HM_EDOMAIN;
+  return HM_OK;
+}
+
+static void clean(hm_order_lines o, double *x, const double *v, size_t n, double fs, size_t nfft, double f_lo,
+                  double f_hi, const double *tre, const double *tim, const double *tpow, hm_order_lines_result *out);
+
+hm_status hm_order_lines_clean(hm_order_lines o, double *x, const double *v, size_t n, double fs, size_t nfft,
+                               double f_lo, double f_hi, hm_order_lines_result *out) {
+  const hm_status st = check(o, x, v, n, fs, nfft, f_lo, f_hi, out);
+  if (st != HM_OK) return st;
+  spectrum(o, x, n, nfft, o->tre, o->tim, o->tpow);
+  clean(o, x, v, n, fs, nfft, f_lo, f_hi, o->tre, o->tim, o->tpow, out);
+  return HM_OK;
+}
+
+hm_status hm_order_lines_clean_dft(hm_order_lines o, double *x, const double *v, size_t n, double fs, size_t nfft,
+                                   double f_lo, double f_hi, const double *re, const double *im, const double *pw,
+                                   hm_order_lines_result *out) {
+  const hm_status st = check(o, x, v, n, fs, nfft, f_lo, f_hi, out);
+  if (st != HM_OK) return st;
+  if (!re || !im || !pw) return HM_EINVAL;
+  clean(o, x, v, n, fs, nfft, f_lo, f_hi, re, im, pw, out);
+  return HM_OK;
+}
+
+/* The lines found in distance and taken out of x (the window's DFT in time in tre, tim, tpow). */
+static void clean(hm_order_lines o, double *x, const double *v, size_t n, double fs, size_t nfft, double f_lo,
+                  double f_hi, const double *tre, const double *tim, const double *tpow, hm_order_lines_result *out) {
   hm_order_lines_result r;
   memset(&r, 0, sizeof r);
   /* each sample's distance (and the speed's range), and the window resampled equally in distance (its virtual
@@ -168,15 +197,14 @@ hm_status hm_order_lines_clean(hm_order_lines o, double *x, const double *v, siz
     const double u = fmin(fmax((sj - o->s[i]) / (o->s[i + 1] - o->s[i]), 0.0), 1.0);
     o->dre[j] = cubic(x, n, i, u);
   }
-  memcpy(o->tre, o->dre, n * sizeof(double)); /* (spectrum() reads its input from a separate array) */
-  spectrum(o, o->tre, n, nfft, o->dre, o->dim, o->dpow);
-  spectrum(o, x, n, nfft, o->tre, o->tim, o->tpow);
+  memcpy(o->s, o->dre, n * sizeof(double)); /* (spectrum() reads its input from a separate array: s is free now) */
+  spectrum(o, o->s, n, nfft, o->dre, o->dim, o->dpow);
   const size_t nb = nfft / 2 + 1;
   const double df = fs / (double)nfft, T = (double)n / fs;
   hm_lines_result lr;
   if (hm_lines_find(o->lines, o->dpow, nb, df, T, f_lo, f_hi, 0.0, o->exclude, &lr) != HM_OK) {
     *out = r;
-    return HM_OK;
+    return;
   }
   /* the candidates: a comb's teeth, then the lone ones */
   double cand[HM_ORDER_LINES_MAX];
@@ -198,9 +226,9 @@ hm_status hm_order_lines_clean(hm_order_lines o, double *x, const double *v, siz
       continue;
     const double f = fd.omega * fs / (2.0 * HM_PI);
     /* in time: the most line-like peak over the band the line swept */
-    const size_t kt = strongest(o->tpow, nb, df, f, 0.5 * f * spread + 1.0 / T, m);
+    const size_t kt = strongest(tpow, nb, df, f, 0.5 * f * spread + 1.0 / T, m);
     const double ft_stat =
-        kt != 0 && hm_lines_fit_sinusoid(o->tre, o->tim, nb, kt, n, nfft, &ft) == HM_OK ? ft.f_stat : 0.0;
+        kt != 0 && hm_lines_fit_sinusoid(tre, tim, nb, kt, n, nfft, &ft) == HM_OK ? ft.f_stat : 0.0;
     if (!(fd.f_stat >= o->cfg.dominance * ft_stat)) continue;
     int dup = 0; /* a tooth also listed as a lone candidate */
     for (unsigned q = 0; q < r.n; ++q) dup |= fabs(r.f_hz[q] - f) < 1.0 / T;
@@ -229,5 +257,4 @@ hm_status hm_order_lines_clean(hm_order_lines o, double *x, const double *v, siz
     }
   }
   *out = r;
-  return HM_OK;
 }
