@@ -19,6 +19,7 @@ enum { NPM = HM_WHITTLE_MAX_NP };
  * objective (the choice by likelihood ratio needs no more). */
 enum { HM_MODAL_MAX_ITER2 = 25, HM_MODAL_SCREEN_ITER2 = 8, HM_MODAL_SPLIT_EVERY = 5 };
 #define HM_MODAL_TOL2 1e-7
+#define HM_MODAL_WARM2_MIN_LR (0.5 * HM_MODAL_TWO_PAIR_LR_WEAK)
 
 /* The warm start of one kind of reading (the window's, and the one with its lone lines left out). */
 typedef struct {
@@ -61,7 +62,7 @@ void hm_modal_config_default(hm_modal_config *c) {
   c->band_low_hz = 6.0;
   c->band_high_hz = 22.0;
   c->fit_interval_s = 1.0;
-  c->tol = 1e-10;
+  c->tol = 1e-7;
   c->max_iter = 80;
   hm_lines_config lc;
   hm_lines_config_default(&lc);
@@ -489,9 +490,11 @@ static int fit_reading(hm_modal m, warm_start *ws, const window_geometry *g, siz
     ws->since_split = 0;
   }
   const int found2 = n2 > 0 && fit_two_pairs(m, &d, g, (const double(*)[NPM])starts2, n2, obj1, th2, &obj2, f2, &iters);
-  ws->have2 = found2 && in_band(m, th2[HM_W_W0]) && in_band(m, th2[HM_W_W02]);
-  if (found2) memcpy(ws->th2, th2, sizeof th2);
   const double lr = found2 ? 2.0 * (obj1 - obj2) / g->padding : 0.0;
+  /* followed from fit to fit where the second pair holds something (half the weak alternative's evidence); else only
+   * the splits look again (a second pair warm-started at every fit for nothing was 45% of a ramp's scoring steps) */
+  ws->have2 = found2 && lr > HM_MODAL_WARM2_MIN_LR && in_band(m, th2[HM_W_W0]) && in_band(m, th2[HM_W_W02]);
+  if (found2) memcpy(ws->th2, th2, sizeof th2);
   const int tells = found2 && lr > HM_MODAL_TWO_PAIR_LR_WEAK && two_pairs_tell(m, g, th2, th1);
   const int two = tells && lr > HM_MODAL_TWO_PAIR_LR;
   *poles = two ? 2 : 1;
