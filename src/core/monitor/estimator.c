@@ -24,6 +24,7 @@ struct hm_estimator_s {
   double t_last, t_start;        /* last accepted sample, start of the current run (after a gap) */
   double x_prev;                 /* previous band-passed value */
   double ms;                     /* mean square of the band-passed signal */
+  double ms_dt, ms_gain;         /* its one-pole gain 1 - exp(-dt / (tracking_time / 2)) and the dt it is for */
   /* zero crossings: a ring of up-crossing times, with the running sum of x^2 and the sample count at each */
   double *cross, *cross_sum, *cross_count;
   double sum_sq, count;          /* running sum of x^2 and number of samples since the restart */
@@ -145,6 +146,7 @@ static void restart_signal(hm_estimator e) {
   e->have_sample = 0;
   e->x_prev = 0.0;
   e->ms = 0.0;
+  e->ms_dt = NAN; /* (the gain computed at the first sample) */
   e->cross_head = e->cross_n = 0;
   e->sum_sq = e->count = 0.0;
   e->trk_f = e->trk_amp = 0.0;
@@ -349,7 +351,9 @@ static void process(hm_estimator e, double t, double dt, double a) {
   double x = a;
   for (int k = 0; k < BAND_SECTIONS; ++k) x = hm_biquad_step(&e->band[k], x);
   /* mean square with time constant tracking_time / 2 */
-  e->ms += (1.0 - exp(-dt / (0.5 * e->cfg.tracking_time_s))) * (x * x - e->ms);
+  if (dt != e->ms_dt) /* (dt is the filters' grid's: an exp once, not a sample) */
+    e->ms_dt = dt, e->ms_gain = 1.0 - exp(-dt / (0.5 * e->cfg.tracking_time_s));
+  e->ms += e->ms_gain * (x * x - e->ms);
   /* up-crossings, armed once the signal went below -10% of the amplitude */
   const double h = fmax(0.1 * amplitude(e), 1e-9);
   if (x < -h) e->armed = 1;

@@ -34,6 +34,18 @@ static inline double spectrum_b(unsigned poles, const pair_k *c1, const pair_k *
   return b * (pair_term(c1, w, &a1, &b1) + (poles == 2 ? rho * pair_term(c2, w, &a2, &b2) : 0.0)) + noise;
 }
 
+/* frexp of a normal positive x (the running product's: at most four factors of [1e-70, 1e70] times one of
+ * [0.5, 1)): its mantissa in [0.5, 1) back in x, its exponent returned; inline, where libm's frexp is a call every
+ * four bins. */
+static inline int split_exponent(double *x) {
+  uint64_t bits;
+  memcpy(&bits, x, sizeof bits);
+  const int e = (int)((bits >> 52) & 0x7ffu) - 1022;
+  bits = (bits & ~(0x7ffull << 52)) | (1022ull << 52);
+  memcpy(x, &bits, sizeof bits);
+  return e;
+}
+
 static inline double background(const double *th, double u) {
   return th[HM_W_C0] + u * (th[HM_W_C1] + u * (th[HM_W_C2] + u * th[HM_W_C3]));
 }
@@ -43,8 +55,8 @@ enum { BLOCK = 64 }; /* bins a block: its columns of J (NPM x BLOCK doubles, 5 k
 /* The objective at th and, when f is not NULL, the Fisher information J'J in f and the score J'(I/S - 1) in g: one
  * pass over blocks of bins, each in loops the compiler vectorises (B's exponent, B, S and J's columns, then J'J and
  * J'(I/S - 1) as dot products of the columns), and one log a pass (the sum of ln S as the logarithm of a product
- * renormalised every four bins by frexp: the same to rounding as a log a bin, a fifth of the pass's time). poles is
- * a constant in each caller below, so that the loops unroll. */
+ * renormalised every four bins by split_exponent: the same to rounding as a log a bin, a fifth of the pass's time).
+ * poles is a constant in each caller below, so that the loops unroll. */
 static inline double evaluate_n(const hm_whittle_data *d, const unsigned poles, const double *th, double f[NPM][NPM],
                                 double *g) {
   const unsigned np = hm_whittle_np(poles);
@@ -99,11 +111,7 @@ static inline double evaluate_n(const hm_whittle_data *d, const unsigned poles, 
         prod *= sk;
       else
         l_rest += log(sk);
-      if (((k0 + i) & 3u) == 3u) {
-        int ex;
-        prod = frexp(prod, &ex);
-        exp2_sum += ex;
-      }
+      if (((k0 + i) & 3u) == 3u) exp2_sum += split_exponent(&prod);
     }
     if (!f) continue;
     for (unsigned a = 0; a < np; ++a) {
