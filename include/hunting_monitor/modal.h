@@ -112,7 +112,7 @@ typedef struct {
   unsigned poles;              /* pole pairs the likelihood chose: 1, or 2 (a second resonance beside the mode) */
   double second_frequency_hz, second_decay_rate_1_s; /* the other pair of two (0 with one) */
   double two_pair_lr;          /* 2 (L1 - L2) over the independent ordinates: two pairs are chosen above
-                                  HM_MODAL_TWO_PAIR_LR (0 when the two-pair fit did not converge) */
+                                  HM_MODAL_TWO_PAIR_LR (0 when none was tried or none converged) */
   double decay_rate_alt_1_s;   /* with one pair chosen but two telling a mode beside another resonance at a likelihood
                                   ratio above HM_MODAL_TWO_PAIR_LR_WEAK: the two pairs' mode's decay rate (0: none).
                                   The evidence cannot choose: the margin counts the difference as an error of the

@@ -166,6 +166,8 @@ static void dft_given_is_the_same(void) {
   for (int i = 0; i < N; ++i) worst = fmax(worst, fabs(x[i] - y[i]));
   HM_CHECK(worst < 1e-9, "x differs by %g", worst);
   HM_CHECK(hm_order_lines_clean_dft(o, y, v, N, FS, NFFT, 2.5, 30.0, re, NULL, pw, &q) == HM_EINVAL, "NULL im");
+  v[7] = NAN; /* (a NULL argument is HM_EINVAL whatever else is wrong, as for hm_order_lines_clean) */
+  HM_CHECK(hm_order_lines_clean_dft(o, y, v, N, FS, NFFT, 2.5, 30.0, NULL, im, pw, &q) == HM_EINVAL, "NULL re");
   hm_order_lines_destroy(o);
 }
 

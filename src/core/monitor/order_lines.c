@@ -141,10 +141,10 @@ static double ratio_at(const hm_order_lines o, const double *pw, size_t nb, doub
   return bg > 0.0 ? pw[k] / bg : INFINITY;
 }
 
-/* hm_order_lines_clean's arguments' checks (order_lines.h). */
+/* hm_order_lines_clean's arguments' checks (order_lines.h; dft: 0 when not given, else its three arrays all given). */
 static hm_status check(const hm_order_lines o, const double *x, const double *v, size_t n, double fs, size_t nfft,
-                       double f_lo, double f_hi, const void *out) {
-  if (!o || !x || !v || !out || n < 8 || n > o->max_n || nfft < n || nfft > o->nfft_max ||
+                       double f_lo, double f_hi, int dft, const void *out) {
+  if (!o || !x || !v || !out || !dft || n < 8 || n > o->max_n || nfft < n || nfft > o->nfft_max ||
       (nfft & (nfft - 1)) != 0 || !(fs > 0.0) || !(f_lo > 0.0) || !(f_hi > f_lo))
     return HM_EINVAL;
   for (size_t i = 0; i < n; ++i)
@@ -157,7 +157,7 @@ static void clean(hm_order_lines o, double *x, const double *v, size_t n, double
 
 hm_status hm_order_lines_clean(hm_order_lines o, double *x, const double *v, size_t n, double fs, size_t nfft,
                                double f_lo, double f_hi, hm_order_lines_result *out) {
-  const hm_status st = check(o, x, v, n, fs, nfft, f_lo, f_hi, out);
+  const hm_status st = check(o, x, v, n, fs, nfft, f_lo, f_hi, 1, out);
   if (st != HM_OK) return st;
   spectrum(o, x, n, nfft, o->tre, o->tim, o->tpow);
   clean(o, x, v, n, fs, nfft, f_lo, f_hi, o->tre, o->tim, o->tpow, out);
@@ -167,9 +167,8 @@ hm_status hm_order_lines_clean(hm_order_lines o, double *x, const double *v, siz
 hm_status hm_order_lines_clean_dft(hm_order_lines o, double *x, const double *v, size_t n, double fs, size_t nfft,
                                    double f_lo, double f_hi, const double *re, const double *im, const double *pw,
                                    hm_order_lines_result *out) {
-  const hm_status st = check(o, x, v, n, fs, nfft, f_lo, f_hi, out);
+  const hm_status st = check(o, x, v, n, fs, nfft, f_lo, f_hi, re && im && pw, out);
   if (st != HM_OK) return st;
-  if (!re || !im || !pw) return HM_EINVAL;
   clean(o, x, v, n, fs, nfft, f_lo, f_hi, re, im, pw, out);
   return HM_OK;
 }

@@ -28,6 +28,10 @@
 #include <stdint.h>
 #include <string.h>
 
+#if defined(__FAST_MATH__)
+#error "whittle.h: hm_whittle_exp and the pass's NaN test need IEEE arithmetic (build without -ffast-math)"
+#endif
+
 /* The window's leakage as a width [1/s] times T (above). */
 #define HM_WHITTLE_LEAKAGE 2.0
 
@@ -61,9 +65,9 @@ static inline double hm_whittle_exp(double x) {
   p = p * r + 0.5;
   p = p * r + 1.0;
   p = p * r + 1.0;
-  int64_t bits;
+  uint64_t bits; /* (unsigned: k < 0 wraps, where a signed shift would be undefined) */
   memcpy(&bits, &t, sizeof bits);
-  bits = (bits - 0x4338000000000000LL + 1023) << 52; /* (t's low bits hold k) */
+  bits = (bits - 0x4338000000000000u + 1023u) << 52; /* (t's low bits hold k) */
   double scale;
   memcpy(&scale, &bits, sizeof scale);
   return p * scale;
