@@ -219,9 +219,10 @@ static int damped_step(const double f[NPM][NPM], const double *g, unsigned np, d
 }
 
 /* One Levenberg-damped scoring step from th (objective l, information f, score g); 1 when a step was taken (th, l,
- * f, g updated; *change its relative decrease), 0 at a stationary point (no descent left, or only rounding). */
+ * f, g updated; *change its relative decrease, *raised whether the damping had to be raised for it), 0 at a
+ * stationary point (no descent left, or only rounding). */
 static int step(const hm_whittle_data *d, unsigned poles, double tol, double *th, double *l, double f[NPM][NPM],
-                double *g, double *mu, double *change) {
+                double *g, double *mu, double *change, int *raised) {
   const unsigned np = hm_whittle_np(poles);
   for (int tries = 0; tries < 30; ++tries) {
     double st[NPM], trial[NPM], ft[NPM][NPM], gt[NPM];
@@ -243,6 +244,7 @@ static int step(const hm_whittle_data *d, unsigned poles, double tol, double *th
       memcpy(g, gt, sizeof gt);
       *l = lt;
       *mu = fmax(*mu * 0.3, 1e-9);
+      *raised = tries > 0;
       return 1;
     }
     if (isfinite(lt) && (lt - *l) / (fabs(*l) + 1.0) < tol) return 0; /* at the optimum to the tolerance */
@@ -256,12 +258,15 @@ int hm_whittle_score(const hm_whittle_data *d, unsigned poles, double *th, doubl
                      double *obj, double fisher[NPM][NPM], unsigned *iters) {
   double f[NPM][NPM], g[NPM], mu = 1e-3, change = 0.0;
   double l = evaluate(d, poles, th, f, g);
-  int converged = 0;
+  int converged = 0, raised = 0;
   unsigned it = 0;
   while (it < max_iter && !converged) {
     ++it;
-    if (!step(d, poles, tol, th, &l, f, g, &mu, &change)) converged = 1;
-    else converged = change < tol;
+    /* a small decrease is convergence only from a step the damping did not have to shorten (a shortened one is small
+     * because it was shortened: review of 2026-12-04, a line reading stopped so at sigma -0.002 where it goes on to
+     * -0.03) */
+    if (!step(d, poles, tol, th, &l, f, g, &mu, &change, &raised)) converged = 1;
+    else converged = change < tol && !raised;
   }
   *iters = it;
   *obj = l;
