@@ -46,6 +46,7 @@ static inline int split_exponent(double *x) {
   return e;
 }
 
+/* ln B(u) (whittle.h). */
 static inline double background(const double *th, double u) {
   return th[HM_W_C0] + u * (th[HM_W_C1] + u * (th[HM_W_C2] + u * th[HM_W_C3]));
 }
@@ -63,7 +64,6 @@ static inline double evaluate_n(const hm_whittle_data *d, const unsigned poles, 
   const double noise = exp(th[HM_W_LN]), rho = poles == 2 ? exp(th[HM_W_LNRHO]) : 0.0;
   const pair_k c1 = pair_constants(th[HM_W_SIGMA], th[HM_W_W0], d->window_s);
   const pair_k c2 = poles == 2 ? pair_constants(th[HM_W_SIGMA2], th[HM_W_W02], d->window_s) : c1;
-  const double cb[4] = {th[HM_W_C0], th[HM_W_C1], th[HM_W_C2], th[HM_W_C3]};
   double l_rest = 0.0, prod = 1.0;
   long exp2_sum = 0;
   if (f) {
@@ -75,7 +75,7 @@ static inline double evaluate_n(const hm_whittle_data *d, const unsigned poles, 
     const double *w = d->w + k0, *u = d->u + k0, *pg = d->pgram + k0;
     double b[BLOCK], s[BLOCK], q[BLOCK], col[NPM][BLOCK]; /* B, S, I / S and J's columns (d ln S / d theta) */
     long wide = 0;
-    for (size_t i = 0; i < nk; ++i) b[i] = cb[0] + u[i] * (cb[1] + u[i] * (cb[2] + u[i] * cb[3]));
+    for (size_t i = 0; i < nk; ++i) b[i] = background(th, u[i]);
     for (size_t i = 0; i < nk; ++i) wide |= (long)((b[i] < -708.0) | (b[i] > 708.0) | (b[i] != b[i]));
     if (!wide)
       for (size_t i = 0; i < nk; ++i) b[i] = hm_whittle_exp(b[i]);
@@ -315,6 +315,6 @@ void hm_whittle_split_start(const double *th1, double window_s, double narrow, d
 double hm_whittle_peak(const double *th, unsigned pair, double window_s, double w_ref) {
   const double sg = pair ? th[HM_W_SIGMA2] : th[HM_W_SIGMA], w0 = fabs(pair ? th[HM_W_W02] : th[HM_W_W0]);
   const double u = log(w0 / w_ref);
-  const double b = exp(th[HM_W_C0] + u * (th[HM_W_C1] + u * (th[HM_W_C2] + u * th[HM_W_C3])));
+  const double b = exp(background(th, u));
   return (pair ? exp(th[HM_W_LNRHO]) : 1.0) * b * pair_peak(sg, w0, window_s);
 }
