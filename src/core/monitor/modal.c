@@ -477,6 +477,10 @@ static int fit_reading(hm_modal m, warm_start *ws, const window_geometry *g, siz
     ws->have2 = 0;
     return 0;
   }
+  /* a negligible noise tried again from a noise the spectrum's size at the splits' pace: a local minimum the scoring
+   * cannot leave, which the warm start would otherwise follow from fit to fit (whittle.h) */
+  const int splits = ws->since_split + 1 >= HM_MODAL_SPLIT_EVERY;
+  if (splits) hm_whittle_reseed_noise(&d, 1, th1, m->cfg.tol, m->cfg.max_iter, &obj1, f1, &iters);
   memcpy(ws->th1, th1, sizeof th1);
   /* two pairs */
   double th2[NPM], f2[NPM][NPM], obj2, starts2[3][NPM];
@@ -484,10 +488,12 @@ static int fit_reading(hm_modal m, warm_start *ws, const window_geometry *g, siz
   if (ws->have2) memcpy(starts2[n2++], ws->th2, sizeof starts2[0]);
   /* the one pair's splits every HM_MODAL_SPLIT_EVERY fits (from the first): the warm start follows a resonance once
    * found, the splits find a new one */
-  if (++ws->since_split >= HM_MODAL_SPLIT_EVERY) {
+  if (splits) {
     hm_whittle_split_start(th1, g->T, 0.4, starts2[n2++]);
     hm_whittle_split_start(th1, g->T, 0.15, starts2[n2++]);
     ws->since_split = 0;
+  } else {
+    ++ws->since_split;
   }
   const int found2 = n2 > 0 && fit_two_pairs(m, &d, g, (const double(*)[NPM])starts2, n2, obj1, th2, &obj2, f2, &iters);
   const double lr = found2 ? 2.0 * (obj1 - obj2) / g->padding : 0.0;

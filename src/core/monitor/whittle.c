@@ -185,7 +185,7 @@ void hm_whittle_variances(const double fisher[NPM][NPM], unsigned np, double sca
  * second pair, may be absent. */
 static void clamp(double *th, unsigned poles) {
   th[HM_W_SIGMA] = fmin(th[HM_W_SIGMA], 0.0);
-  th[HM_W_LN] = fmax(th[HM_W_LN], -60.0);
+  th[HM_W_LN] = fmax(th[HM_W_LN], HM_WHITTLE_LN_FLOOR);
   if (poles == 2) {
     th[HM_W_SIGMA2] = fmin(th[HM_W_SIGMA2], 0.0);
     th[HM_W_LNRHO] = fmax(th[HM_W_LNRHO], -40.0);
@@ -254,10 +254,11 @@ static int step(const hm_whittle_data *d, unsigned poles, double tol, double *th
   return 0;
 }
 
-int hm_whittle_score(const hm_whittle_data *d, unsigned poles, double *th, double tol, unsigned max_iter,
-                     double *obj, double fisher[NPM][NPM], unsigned *iters) {
-  double f[NPM][NPM], g[NPM], mu = 1e-3, change = 0.0;
-  double l = evaluate(d, poles, th, f, g);
+/* Scoring from th (in place) by at most max_iter steps; *l and f set, the steps added to *iters; 1 if converged. */
+static int score_from(const hm_whittle_data *d, unsigned poles, double *th, double tol, unsigned max_iter, double *l,
+                      double f[NPM][NPM], unsigned *iters) {
+  double g[NPM], mu = 1e-3, change = 0.0;
+  *l = evaluate(d, poles, th, f, g);
   int converged = 0, raised = 0;
   unsigned it = 0;
   while (it < max_iter && !converged) {
@@ -265,13 +266,39 @@ int hm_whittle_score(const hm_whittle_data *d, unsigned poles, double *th, doubl
     /* a small decrease is convergence only from a step the damping did not have to shorten (a shortened one is small
      * because it was shortened: review of 2026-12-04, a line reading stopped so at sigma -0.002 where it goes on to
      * -0.03) */
-    if (!step(d, poles, tol, th, &l, f, g, &mu, &change, &raised)) converged = 1;
+    if (!step(d, poles, tol, th, l, f, g, &mu, &change, &raised)) converged = 1;
     else converged = change < tol && !raised;
   }
+  *iters += it;
+  return converged && isfinite(*l);
+}
+
+int hm_whittle_score(const hm_whittle_data *d, unsigned poles, double *th, double tol, unsigned max_iter,
+                     double *obj, double fisher[NPM][NPM], unsigned *iters) {
+  double f[NPM][NPM], l;
+  unsigned it = 0;
+  const int converged = score_from(d, poles, th, tol, max_iter, &l, f, &it);
   *iters = it;
   *obj = l;
   memcpy(fisher, f, sizeof f);
-  return converged && isfinite(l);
+  return converged;
+}
+
+int hm_whittle_reseed_noise(const hm_whittle_data *d, unsigned poles, double *th, double tol, unsigned max_iter,
+                            double *obj, double fisher[NPM][NPM], unsigned *iters) {
+  if (d->n == 0) return 0;
+  double mean = 0.0;
+  for (size_t k = 0; k < d->n; ++k) mean += d->pgram[k];
+  mean /= (double)d->n;
+  double t[NPM], ft[NPM][NPM], lt;
+  memcpy(t, th, sizeof t);
+  t[HM_W_LN] = log(mean);
+  if (!isfinite(t[HM_W_LN]) || !(th[HM_W_LN] < t[HM_W_LN] + HM_WHITTLE_LN_NEGLIGIBLE)) return 0;
+  if (!score_from(d, poles, t, tol, max_iter, &lt, ft, iters) || !(lt < *obj)) return 0;
+  memcpy(th, t, sizeof t);
+  memcpy(fisher, ft, sizeof ft);
+  *obj = lt;
+  return 1;
 }
 
 /* A pair's term at its own frequency (the peak), Re F(a) / (a^2 + 4 w0^2). */
