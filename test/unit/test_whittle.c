@@ -96,19 +96,20 @@ static void a_line_is_sigma_zero(void) {
   HM_CHECK(isfinite(var[HM_W_SIGMA]) && var[HM_W_SIGMA] > 0.0, "finite error at sigma 0: %g", var[HM_W_SIGMA]);
 }
 
-/* A negligible noise is no trap (review of 2026-12-04): where the noise is negligible d ln S / d ln N vanishes and no
- * step raises it. The review's window (a -6.5 1/s mode at 14.27 Hz, the white noise a fifth of the median
- * periodogram: the optimum it found, here the truth) as a periodogram drawn from it (each bin the spectrum times an
- * exponential variate, seeded), fitted from the review's trapped start (a broader pair, ln N at the floor -60, then
- * at -20 where the crawl stopped), scored and then, as the identification does every fifth fit, retried from a
- * reseeded noise (hm_whittle_reseed_noise): every start must end at the best objective over starts with the noise at
- * its true level and a factor e either side (a second way to the optimum; the trapped fits ended 0.03-1.0 above it,
- * the decay rate up to 0.4 1/s off). And a spectrum without noise is fitted back as it was (the retry from a noise
- * at the periodogram's mean is kept only if it is better). */
+/* A negligible noise is no trap (review of 2026-12-04): where the noise is negligible d ln S / d ln N vanishes and
+ * steps crawl or go on down to the floor. The review's window (a -6.5 1/s mode at 14.27 Hz, the white noise a fifth
+ * of the median periodogram: the optimum it found, here the truth) as periodograms drawn from it (each bin the
+ * spectrum times an exponential variate, 40 seeds), fitted from the review's trapped start (a broader pair, ln N at
+ * the floor -60, then at -20 where the crawl stopped), scored and then, as the identification does every fifth fit,
+ * retried (hm_whittle_reseed_noise): every start must end at the best objective over starts with the noise at its
+ * true level and a factor e either side (a second way to the optimum; before the retry the trapped fits ended up to
+ * 1.0 above it, the decay rate up to 0.4 1/s off; a retry from the noise at the periodogram's mean alone, with the
+ * trapped cubic background kept, still failed 5 of 200 seeds, review of ac12d3a). And a spectrum without noise is
+ * fitted back as it was (the retry is kept only if it is better). */
 static void a_negligible_noise_is_no_trap(void) {
   const double tt[HM_WHITTLE_MAX_NP] = {-6.541286, 89.658298, 13.979036, 0.231159, -6.113023, -7.397272, -3.260777};
   const double trapped[HM_WHITTLE_MAX_NP] = {-5.89046, 89.0901, 13.9182, 0.558154, -1.2898, -2.47813, 0.0};
-  for (uint64_t seed = 1; seed <= 4; ++seed) {
+  for (uint64_t seed = 1; seed <= 40; ++seed) {
     bins b;
     make_bins(&b, tt, 1);
     uint64_t x = 0x9E3779B97F4A7C15ull * seed;
@@ -135,7 +136,7 @@ static void a_negligible_noise_is_no_trap(void) {
       HM_CHECK(obj <= best + 1e-6 * fabs(best), "seed %u from ln N %g: the objective %.9g against %.9g", (unsigned)seed,
                starts[k], obj, best);
       HM_CHECK_DELTA(th[HM_W_SIGMA], best_sigma, 1e-2, "the decay rate");
-      if (k == 0)
+      if (k == 0 && seed <= 4)
         printf("  seed %u, from ln N at the floor: decay rate %.4f (%.4f from the noise's level), ln N %.3f, %u steps\n",
                (unsigned)seed, th[HM_W_SIGMA], best_sigma, th[HM_W_LN], it);
     }

@@ -290,10 +290,17 @@ int hm_whittle_reseed_noise(const hm_whittle_data *d, unsigned poles, double *th
   double mean = 0.0;
   for (size_t k = 0; k < d->n; ++k) mean += d->pgram[k];
   mean /= (double)d->n;
+  const double ln_mean = log(mean);
+  if (!isfinite(ln_mean) || !(th[HM_W_LN] < ln_mean + HM_WHITTLE_LN_NEGLIGIBLE)) return 0;
+  /* from a flat background at the level the cubic had at the pair's frequency: a curved one held the floor the
+   * noise would explain, and from it the scoring slid back to a negligible noise (review of ac12d3a) */
   double t[NPM], ft[NPM][NPM], lt;
   memcpy(t, th, sizeof t);
-  t[HM_W_LN] = log(mean);
-  if (!isfinite(t[HM_W_LN]) || !(th[HM_W_LN] < t[HM_W_LN] + HM_WHITTLE_LN_NEGLIGIBLE)) return 0;
+  const double u0 = d->u[0] + log(fabs(th[HM_W_W0]) / d->w[0]);
+  t[HM_W_C0] = background(th, u0);
+  t[HM_W_C1] = t[HM_W_C2] = t[HM_W_C3] = 0.0;
+  t[HM_W_LN] = ln_mean + HM_WHITTLE_RESEED_LN;
+  if (!isfinite(t[HM_W_C0])) return 0;
   if (!score_from(d, poles, t, tol, max_iter, &lt, ft, iters) || !(lt < *obj)) return 0;
   memcpy(th, t, sizeof t);
   memcpy(fisher, ft, sizeof ft);
