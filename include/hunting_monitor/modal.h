@@ -163,6 +163,13 @@ typedef struct {
    * subtraction of one sinusoid leaves); line_reading itself where it does not. For a peak known for a line only
    * (narrow_peak_tracked: a narrow mode's own core is no skirt) */
   hm_mode_reading line_reading_wide;
+  /* the narrow peak's envelope (envelope.h, private): the window demodulated at narrow_peak_hz over a band of
+   * max(HM_MODAL_ENVELOPE_BAND_HZ, 2 f spread + 4 / T) (a line's sweep on a ramp inside it), its ratio <|z|^4> /
+   * <|z|^2>^2 (2 for a mode, a Gaussian process; near 1 for a line holding the band), and the ratio a line would give
+   * that held the band's power above the continuum beside the peak (the line search's local background, which holds
+   * a narrow mode's own skirt: for a mode the two are close). Reported, not used: in one window they tell a line from
+   * a mode only where the peak holds most of the band (docs/TESTS.md). NAN, NAN when not measured. */
+  double narrow_peak_envelope_ratio, narrow_peak_line_ratio;
   /* set by the caller that tracks lines across windows (monitor.h, track_lines.h), 0 from the fit: the narrow peak's
    * wavelength V / f [m] in a window at one steady speed, and 1 when that wavelength was seen at another steady speed
    * (a track line, not the mode) */
@@ -185,6 +192,9 @@ typedef struct {
 /* ... and for one the mode sits on while as narrow as a line (F(2, 12) beyond it: 5e-3; a mode at -0.1 to -0.56 1/s
  * reached 4-14 on its own peak, a weak line fitted as a mode of -0.23 1/s 11.7). */
 #define HM_MODAL_LINE_F_ON_MODE 8.0
+/* The narrow peak's envelope is read over at least this band [Hz] (narrow_peak_envelope_ratio): the filter's 20-40
+ * independent values in a window. */
+#define HM_MODAL_ENVELOPE_BAND_HZ 1.0
 /* A reading is informative when decay_rate_se <= HM_MODAL_INFORMATIVE_SE_1_S + HM_MODAL_INFORMATIVE_REL |sigma|. */
 #define HM_MODAL_INFORMATIVE_SE_1_S 0.5
 #define HM_MODAL_INFORMATIVE_REL 0.5

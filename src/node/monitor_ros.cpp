@@ -476,6 +476,8 @@ void MonitorRos::fillMode(const hm_report& r, hunting_monitor::HuntingStatus& m)
   m.narrow_peak_verdict_text = r.narrow_peak_taken_for;
   m.narrow_peak_wavelength_m = finite(r.narrow_peak_wavelength_m);
   m.narrow_peak_tracked = r.narrow_peak_tracked;
+  m.narrow_peak_envelope_ratio = finite(r.narrow_peak_envelope_ratio);
+  m.narrow_peak_line_ratio = finite(r.narrow_peak_line_ratio);
   m.speed_tracking_measured = std::isfinite(r.mode_speed_tracking);
   m.mode_speed_tracking = finite(r.mode_speed_tracking);
   m.mode_speed_tracking_se = finite(r.mode_speed_tracking_se);

@@ -270,12 +270,15 @@ static void a_line_alone_and_a_narrow_mode(void) {
   HM_CHECK(hm_modal_create(&c, fs, &m, NULL, 0) == HM_OK, "create");
   if (!m) return;
   double t = 0.0;
-  int narrow = 0, aside = 0, taken = 0, beside = 0;
+  int narrow = 0, aside = 0, taken = 0, beside = 0, enveloped = 0;
+  double worst_ratio = 0.0;
   for (int win = 0; win < 10; ++win) {
     hm_mode_estimate e;
     if (fit_window(m, fs, T, NULL, NULL, 1.0, 14.0, 1.0, &t, &e) != HM_OK) continue;
     narrow += e.narrow_peak && fabs(e.narrow_peak_hz - 14.0) < 0.01 &&
               fabs(e.decay_rate_1_s) <= 2.0 * e.decay_rate_se_1_s + 0.5 / T;
+    if (e.narrow_peak && isfinite(e.narrow_peak_envelope_ratio)) /* a line's envelope is steady (envelope.h) */
+      ++enveloped, worst_ratio = fmax(worst_ratio, e.narrow_peak_envelope_ratio - e.narrow_peak_line_ratio);
     aside += (e.lone_lines > 0 && fabs(e.lone_line_hz[0] - 14.0) < 0.01) ||
              (e.lines_found && fabs(e.line_strongest_hz - 14.0) < 0.01);
     taken += e.valid && !e.narrow_peak && fabs(e.frequency_hz - 14.0) < 0.05; /* read as a mode, silently */
@@ -285,6 +288,9 @@ static void a_line_alone_and_a_narrow_mode(void) {
          "unflagged in %d, a chance mode beside it in %d\n", narrow, aside, taken, beside);
   HM_CHECK(narrow + aside >= 9 && taken == 0 && beside <= 2, "narrow %d, aside %d, taken %d, beside %d", narrow, aside,
            taken, beside);
+  printf("  its envelope measured in %d narrow peaks: the ratio at most %.3f above a line's\n", enveloped, worst_ratio);
+  HM_CHECK(enveloped >= narrow && worst_ratio <= 0.1, "a line's envelope: %d measured, %.3f above a line's", enveloped,
+           worst_ratio);
   pole_pair p = pole_pair_make(-0.1, 14.2, fs, 0.01);
   for (int k = 0; k < 200000; ++k) pole_pair_step(&p);
   int n = 0;

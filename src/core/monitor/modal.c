@@ -7,6 +7,7 @@
 #include <string.h>
 
 #include "biquad.h"
+#include "envelope.h"
 #include "fft.h"
 #include "hunting_monitor/lines.h"
 #include "hunting_monitor/order_lines.h"
@@ -51,6 +52,8 @@ struct hm_modal_s {
   double *power;               /* |X_k|^2 of every bin (the line search) */
   unsigned char *excluded;     /* the bins of a comb of lines; after it, those set aside before a narrow peak's */
   unsigned char *set_aside;    /* the comb's and the lone lines' */
+  double *env_work;            /* the narrow peak's envelope (envelope.h) */
+  size_t env_work_len;
   hm_lines lines;
   warm_start warm[3];          /* the window's reading, the line reading, the line reading without the skirt */
 };
@@ -174,11 +177,14 @@ hm_status hm_modal_create(const hm_modal_config *cfg, double fs, hm_modal *out, 
   m->power = malloc((m->nfft_max / 2 + 1) * sizeof(double));
   m->excluded = malloc(m->nfft_max / 2 + 1);
   m->set_aside = malloc(m->nfft_max / 2 + 1);
+  /* (the decimated rate is below twice the one asked for: rate_plan) */
+  m->env_work_len = hm_envelope_work_size(m->cap, 2.0 * cfg->decimated_rate_hz, HM_MODAL_ENVELOPE_BAND_HZ);
+  m->env_work = malloc(m->env_work_len * sizeof(double));
   const hm_lines_config lc = lines_config(cfg);
   hm_order_lines_config oc;
   hm_order_lines_config_default(&oc);
   if (!m->ring || !m->speed || !m->x || !m->xv || !m->re || !m->im || !m->cosw || !m->sinw || !m->w || !m->pgram ||
-      !m->u || !m->power || !m->excluded || !m->set_aside ||
+      !m->u || !m->power || !m->excluded || !m->set_aside || !m->env_work ||
       hm_lines_create(&lc, m->nfft_max / 2 + 1, &m->lines, NULL, 0) != HM_OK ||
       hm_order_lines_create(&oc, &lc, m->cap, m->nfft_max, &m->order, NULL, 0) != HM_OK) {
     hm_modal_destroy(m);
@@ -207,6 +213,7 @@ void hm_modal_destroy(hm_modal m) {
   free(m->power);
   free(m->excluded);
   free(m->set_aside);
+  free(m->env_work);
   hm_lines_destroy(m->lines);
   free(m);
 }
@@ -798,6 +805,19 @@ static window_geometry geometry(const hm_modal m, size_t n, double speed_spread_
   return g;
 }
 
+/* The narrow peak's envelope (modal.h, envelope.h) from the window's newest n samples: the line hypothesis holds the
+ * band's power above the continuum beside the peak, bg (|X|^2 = n fd S for a two-sided density S: S B in the band). */
+static void narrow_peak_envelope(hm_modal m, const window_geometry *g, double bg, size_t n, hm_mode_estimate *r) {
+  const double band = fmax(HM_MODAL_ENVELOPE_BAND_HZ, 2.0 * r->narrow_peak_hz * g->spread_rel + 4.0 / g->T);
+  hm_envelope_stats es;
+  if (!(bg > 0.0) || hm_envelope_stats_of(m->x + (m->x_len - n), n, m->fd, r->narrow_peak_hz, band, m->env_work,
+                                          m->env_work_len, &es) != HM_OK)
+    return;
+  const double kappa = fmax(es.band_power / (bg / ((double)n * m->fd) * band) - 1.0, 0.0);
+  r->narrow_peak_envelope_ratio = es.ratio;
+  r->narrow_peak_line_ratio = hm_envelope_line_ratio(kappa);
+}
+
 /* A narrow peak (modal.h): reported as such, and the reading with its line set aside too (r->line_reading), then,
  * where that line lies inside the peak of the mode beside it, with the line's skirt left out as well
  * (r->line_reading_wide; skirt_aside: a narrow mode's own core is no skirt: left out, the flanks of a bogie's mode at
@@ -807,6 +827,7 @@ static void narrow_peak_readings(hm_modal m, const window_geometry *g, const hm_
   r->narrow_peak = 1;
   r->narrow_peak_hz = fit->omega * m->fd / (2.0 * HM_PI);
   r->narrow_peak_mps2 = 2.0 * hypot(fit->amp_re, fit->amp_im);
+  narrow_peak_envelope(m, g, bg, n, r);
   const unsigned listed = r->lone_lines;
   set_line_aside(m, g, fit, bg, n, r);
   r->lone_lines = listed; /* the narrow peak is reported as such, not as a lone line */
@@ -832,6 +853,7 @@ hm_status hm_modal_fit(hm_modal m, double max_window_s, double speed_spread_rel,
   hm_mode_estimate r;
   memset(&r, 0, sizeof r);
   r.speed_tracking = r.speed_tracking_se = NAN;
+  r.narrow_peak_envelope_ratio = r.narrow_peak_line_ratio = NAN;
   const size_t n = (size_t)fmin((double)m->n_in, floor(max_window_s * m->fd + 1e-6));
   r.window_s = (double)n / m->fd;
   if (n < m->min_n) {

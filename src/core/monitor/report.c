@@ -103,6 +103,8 @@ static void mode_part(const hm_monitor_status *st, hm_report *r) {
   r->narrow_peak_wavelength_m = when(md->narrow_peak && md->narrow_peak_wavelength_m > 0.0,
                                      md->narrow_peak_wavelength_m);
   r->narrow_peak_tracked = md->narrow_peak && md->narrow_peak_tracked;
+  r->narrow_peak_envelope_ratio = when(md->narrow_peak, md->narrow_peak_envelope_ratio);
+  r->narrow_peak_line_ratio = when(md->narrow_peak, md->narrow_peak_line_ratio);
   r->narrow_peak_taken_for = hm_narrow_verdict_text(st->margin.narrow);
   r->narrow_peak_verdict = (long)st->margin.narrow;
 }
