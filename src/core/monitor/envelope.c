@@ -52,7 +52,6 @@ hm_status hm_envelope_stats_of(const double *x, size_t n, double fs_hz, double f
   if (!(m2 > 0.0) || !isfinite(m4)) return HM_EDOMAIN;
   out->ratio = m4 / (m2 * m2);
   out->band_power = m2;
-  out->independent = bandwidth_hz * (double)n_out / fs_hz;
   return HM_OK;
 }
 

@@ -23,8 +23,6 @@
 typedef struct {
   double ratio;       /* <|z|^4> / <|z|^2>^2 over the filter's outputs (every eighth of its length) */
   double band_power;  /* <|z|^2> [(units of x)^2]: a line of amplitude A gives A^2 / 4 */
-  double independent; /* the band's width times the span of the filter's outputs: the filter's independent values
-                       * (a mode's envelope has fewer: about |sigma| T / pi) */
 } hm_envelope_stats;
 
 /* The doubles hm_envelope_stats_of needs as work: 2 n and the filter's length, round(1.5 fs_hz / bandwidth_hz) - 1;
