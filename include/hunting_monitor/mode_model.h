@@ -161,7 +161,11 @@ hm_status hm_mode_model_reading(hm_mode_model m, double conicity, double speed_k
 
 /* hm_mode_model_invert against the model's reading of `poles` pairs (the measured window's choice) instead of its
  * roots; with no sensor set, hm_mode_model_invert. The step tolerance is at least 1e-6 max(lambda, 1) (a reading's
- * precision). */
+ * precision). A measured (decaying) reading is never explained by a conicity at which the model is unstable at that
+ * speed (any root with a real part >= 0, as hm_mode_model_hopf counts the first crossing of any mode: the vehicle ran
+ * there without hunting): such a result is refused and Gauss-Newton started again from the scanned conicity nearest
+ * the measured mode among those where the model is stable, its steps halved until they stay on that side; HM_ENOCONV
+ * if that fails too. */
 hm_status hm_mode_model_invert_reading(hm_mode_model m, unsigned poles, double speed_kmh, double sigma_m,
                                        double e_sigma, double f_m, double e_f, double tol, unsigned max_iter,
                                        hm_conicity_inversion *out);

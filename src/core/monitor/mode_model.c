@@ -31,6 +31,13 @@ struct hm_mode_model_s {
   double rd_f[NREAD], rd_w[NREAD], rd_u[NREAD], rd_p[NREAD]; /* the reading's bins and the model's spectrum */
 };
 
+/* 1 when every root decays (re < 0). */
+static int stable_roots(const double *re, size_t n) {
+  for (size_t i = 0; i < n; ++i)
+    if (!(re[i] < 0.0)) return 0;
+  return 1;
+}
+
 static hm_status set_conicity(hm_mode_model m, double conicity) {
   if (m->conicity == conicity) return HM_OK;
   hm_vehicle *w = &m->params.bogie.wheelset;
@@ -332,6 +339,13 @@ hm_status hm_mode_model_invert(hm_mode_model m, double speed_kmh, double sigma_m
   return HM_ENOCONV;
 }
 
+/* 1 when the model at conicity and speed is stable (every root decays); 0 also where it cannot be evaluated. */
+static int stable_at(hm_mode_model m, double conicity, double v_kmh) {
+  double re[NMAX], im[NMAX];
+  return conicity > 0.0 && set_conicity(m, conicity) == HM_OK &&
+         hm_system_eig(&m->sys, hm_mps_from_kmh(v_kmh), re, im, NULL) == HM_OK && stable_roots(re, m->sys.dim);
+}
+
 /* The reading and its slope at lambda (a forward difference of 1e-3 lambda, the second fit warm from the first),
  * the fits carried in th1/th2 (*have: warm). */
 static hm_status reading_with_slope(hm_mode_model m, unsigned poles, double lambda, double v_kmh, const ref_mode *ref,
@@ -350,6 +364,30 @@ static hm_status reading_with_slope(hm_mode_model m, unsigned poles, double lamb
   return HM_OK;
 }
 
+/* Gauss-Newton on the reading from lambda; with stay_stable (lambda stable at the speed) a step that would leave the
+ * side where the model is stable is halved until it does not. */
+static hm_status gauss_newton_reading(hm_mode_model m, unsigned poles, double speed_kmh, const ref_mode *ref,
+                                      double lambda, int stay_stable, double tol, unsigned max_iter,
+                                      hm_conicity_inversion *out) {
+  double th1[NPM], th2[NPM];
+  int have = 0;
+  for (unsigned it = 1; it <= max_iter; ++it) {
+    root_point p;
+    if (reading_with_slope(m, poles, lambda, speed_kmh, ref, th1, th2, &have, &p) != HM_OK) return HM_ENOCONV;
+    double step;
+    if (!gauss_newton_step(&p, lambda, ref->sigma, ref->e_sigma, ref->w, ref->e_w, &step)) return HM_ENOCONV;
+    if (fabs(step) > tol * fmax(lambda, 1.0)) {
+      for (int k = 0; k < 40 && stay_stable && !stable_at(m, lambda + step, speed_kmh); ++k) step *= 0.5;
+      lambda += step;
+      continue;
+    }
+    if (!(lambda > 0.0 && lambda < 10.0)) return HM_ENOCONV;
+    inversion_result(&p, lambda, ref->sigma, ref->e_sigma, ref->w, ref->e_w, it, out);
+    return HM_OK;
+  }
+  return HM_ENOCONV;
+}
+
 hm_status hm_mode_model_invert_reading(hm_mode_model m, unsigned poles, double speed_kmh, double sigma_m,
                                        double e_sigma, double f_m, double e_f, double tol, unsigned max_iter,
                                        hm_conicity_inversion *out) {
@@ -360,34 +398,36 @@ hm_status hm_mode_model_invert_reading(hm_mode_model m, unsigned poles, double s
       !(tol > 0.0) || max_iter < 1)
     return HM_EDOMAIN;
   /* the start: the scanned conicity whose reading (the peak the measured mode lies on) is nearest it, then
-   * Gauss-Newton on the reading */
+   * Gauss-Newton on the reading. A decaying reading is never explained by a conicity at which the model is unstable
+   * at this speed (any root, as the Hopf speed counts the first crossing of any mode: the vehicle ran there without
+   * hunting; a bogie's one-pair reading at 523 km/h had been matched to a conicity whose wheelsets' mode grew at
+   * +1.4 1/s, by a stable root's peak beside it): such a result is refused and the search made again from the
+   * nearest scanned conicity where the model is stable, staying on that side. */
   const double w_m = 2.0 * HM_PI * f_m, e_w = 2.0 * HM_PI * e_f;
   const ref_mode ref = {sigma_m, w_m, e_sigma, e_w};
-  double lambda = NAN, best = INFINITY, th1[NPM], th2[NPM];
+  double lambda = NAN, best = INFINITY, lambda_st = NAN, best_st = INFINITY, th1[NPM], th2[NPM];
   for (int k = 0; k < HM_MODE_MODEL_READING_SCAN; ++k) {
     const double l = 0.02 * pow(40.0, (double)k / (HM_MODE_MODEL_READING_SCAN - 1)); /* 0.02..0.8, geometric */
     double s, w;
     if (reading_fit(m, l, speed_kmh, poles, &ref, NULL, NULL, th1, th2, &s, &w) != HM_OK) continue;
     const double d = ref_distance(&ref, s, w);
     if (d < best) best = d, lambda = l;
+    if (d < best_st && stable_at(m, l, speed_kmh)) best_st = d, lambda_st = l;
   }
   if (!isfinite(lambda)) return HM_ENOCONV;
-  int have = 0;
   tol = fmax(tol, 1e-6);
-  for (unsigned it = 1; it <= max_iter; ++it) {
-    root_point p;
-    if (reading_with_slope(m, poles, lambda, speed_kmh, &ref, th1, th2, &have, &p) != HM_OK) return HM_ENOCONV;
-    double step;
-    if (!gauss_newton_step(&p, lambda, sigma_m, e_sigma, w_m, e_w, &step)) return HM_ENOCONV;
-    if (fabs(step) > tol * fmax(lambda, 1.0)) {
-      lambda += step;
-      continue;
-    }
-    if (!(lambda > 0.0 && lambda < 10.0)) return HM_ENOCONV;
-    inversion_result(&p, lambda, sigma_m, e_sigma, w_m, e_w, it, out);
+  hm_conicity_inversion r;
+  if (gauss_newton_reading(m, poles, speed_kmh, &ref, lambda, 0, tol, max_iter, &r) == HM_OK &&
+      stable_at(m, r.conicity, speed_kmh)) {
+    *out = r;
     return HM_OK;
   }
-  return HM_ENOCONV;
+  if (!isfinite(lambda_st) ||
+      gauss_newton_reading(m, poles, speed_kmh, &ref, lambda_st, 1, tol, max_iter, &r) != HM_OK ||
+      !stable_at(m, r.conicity, speed_kmh))
+    return HM_ENOCONV;
+  *out = r;
+  return HM_OK;
 }
 
 /* ---- the spectrum at a sensor ---- */
@@ -700,7 +740,8 @@ static hm_status reading_fit(hm_mode_model m, double conicity, double v_kmh, uns
   pair_of(th, second, &s, &ww);
   /* a stationary spectrum tells |sigma| alone; where the root the read pair follows is unstable there is none to
    * read: the reading is given growing (+|sigma|), so that no measured (decaying) reading is explained there by the
-   * mirror image of the stable side */
+   * mirror image of the stable side (a stable root's peak beside an unstable one is still read as decaying: the
+   * inversion below refuses such conicities) */
   size_t kf = m->sys.dim; /* the oscillatory root the read pair follows: nearest it in frequency */
   for (size_t i = 0; i < m->sys.dim; ++i)
     if (im[i] > 0.0 && (kf == m->sys.dim || fabs(im[i] - ww) < fabs(im[kf] - ww))) kf = i;
