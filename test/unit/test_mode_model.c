@@ -427,6 +427,7 @@ static void unstable_conicities_explain_no_reading(void) {
     if (st == HM_OK) hm_mode_model_hopf(m, inv.conicity, &hopf, NULL, NULL);
     printf("  %u pair(s) %.2f 1/s at %.2f Hz, %.0f km/h: status %d, conicity %.4f, Hopf %.1f km/h\n", r[i].poles,
            r[i].sigma, r[i].f_hz, v, (int)st, st == HM_OK ? inv.conicity : NAN, hopf);
+    HM_CHECK(st == HM_OK, "a stable conicity explains the reading");
     if (st != HM_OK) continue;
     HM_CHECK(hopf > v, "the conicity found leaves the model stable at the window's speed (Hopf speed above it)");
     HM_CHECK(hm_mode_model_least_damped(m, inv.conicity, v, &sl, &wl) == HM_OK && sl < 0.0, "its roots decay");
