@@ -142,6 +142,7 @@ hm_status hm_mode_model_fit_spectrum(hm_mode_model m, double speed_kmh, const hm
 #define HM_MODE_MODEL_READING_TOL 1e-11 /* the fit's relative change of the objective that ends it */
 #define HM_MODE_MODEL_READING_ITER 200
 #define HM_MODE_MODEL_READING_SCAN 16   /* conicities 0.02-0.8 (geometric) the reading's inversion starts from */
+#define HM_MODE_MODEL_EDGE_RTOL 1e-9    /* the stability edge's bisection in the conicity (relative) */
 
 /* The sensor whose reading the model gives ("axlebox", "frame", "carbody" as hm_mode_model_sensor); NULL: none (the
  * inversion by roots). HM_EINVAL for a place the model has not, the sensor unchanged. */
@@ -163,9 +164,13 @@ hm_status hm_mode_model_reading(hm_mode_model m, double conicity, double speed_k
  * roots; with no sensor set, hm_mode_model_invert. The step tolerance is at least 1e-6 max(lambda, 1) (a reading's
  * precision). A measured (decaying) reading is never explained by a conicity at which the model is unstable at that
  * speed (any root with a real part >= 0, as hm_mode_model_hopf counts the first crossing of any mode: the vehicle ran
- * there without hunting): such a result is refused and Gauss-Newton started again from the scanned conicity nearest
- * the measured mode among those where the model is stable, its steps halved until they stay on that side; HM_ENOCONV
- * if that fails too. */
+ * there without hunting). Gauss-Newton starts from the scanned conicity whose reading is nearest the measured mode;
+ * where that conicity is stable, or where Gauss-Newton from an unstable one ends unstable or fails, it runs from the
+ * nearest stable one projected onto the stable side: a step that would leave it ends at its edge (bisected to a
+ * relative HM_MODE_MODEL_EDGE_RTOL), and a step so clipped below the tolerance ends the search there. Such an edge
+ * result (the Hopf speed at the window's speed: the nearest a stable model comes to the reading) is returned with its
+ * misfit chi2 for the caller to judge; its slope is a backward difference, the reading's decay rate changing sign
+ * across the edge. HM_ENOCONV if no stable conicity is reached. */
 hm_status hm_mode_model_invert_reading(hm_mode_model m, unsigned poles, double speed_kmh, double sigma_m,
                                        double e_sigma, double f_m, double e_f, double tol, unsigned max_iter,
                                        hm_conicity_inversion *out);

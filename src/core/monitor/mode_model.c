@@ -346,17 +346,22 @@ static int stable_at(hm_mode_model m, double conicity, double v_kmh) {
          hm_system_eig(&m->sys, hm_mps_from_kmh(v_kmh), re, im, NULL) == HM_OK && stable_roots(re, m->sys.dim);
 }
 
-/* The reading and its slope at lambda (a forward difference of 1e-3 lambda, the second fit warm from the first),
- * the fits carried in th1/th2 (*have: warm). */
+/* The reading and its slope at lambda (a difference of 1e-3 lambda, the second fit warm from the first: forward, or
+ * backward where lambda is stable and lambda + h is not, as the reading's decay rate changes sign where its root
+ * crosses into instability and a difference across that edge is no slope), the fits carried in th1/th2 (*have: warm). */
 static hm_status reading_with_slope(hm_mode_model m, unsigned poles, double lambda, double v_kmh, const ref_mode *ref,
                                     double *th1, double *th2, int *have, root_point *p) {
-  const double h = 1e-3 * lambda;
+  double h = 1e-3 * lambda;
+  if (!stable_at(m, lambda + h, v_kmh) && stable_at(m, lambda, v_kmh)) h = -h;
   double s0, w0, s1, w1, t1[NPM], t2[NPM], u1[NPM], u2[NPM];
   hm_status st = reading_fit(m, lambda, v_kmh, poles, ref, *have ? th1 : NULL, *have && poles == 2 ? th2 : NULL, t1,
                              t2, &s0, &w0);
   if (st != HM_OK && *have) st = reading_fit(m, lambda, v_kmh, poles, ref, NULL, NULL, t1, t2, &s0, &w0);
   if (st != HM_OK) return st;
-  if ((st = reading_fit(m, lambda + h, v_kmh, poles, NULL, t1, t2, u1, u2, &s1, &w1)) != HM_OK) return st;
+  if (reading_fit(m, lambda + h, v_kmh, poles, NULL, t1, t2, u1, u2, &s1, &w1) != HM_OK) {
+    const ref_mode here = {s0, w0, ref->e_sigma, ref->e_w}; /* cold, the fit nearest the reading at lambda */
+    if ((st = reading_fit(m, lambda + h, v_kmh, poles, &here, NULL, NULL, u1, u2, &s1, &w1)) != HM_OK) return st;
+  }
   memcpy(th1, t1, sizeof t1);
   memcpy(th2, t2, sizeof t2);
   *have = 1;
@@ -364,26 +369,62 @@ static hm_status reading_with_slope(hm_mode_model m, unsigned poles, double lamb
   return HM_OK;
 }
 
-/* Gauss-Newton on the reading from lambda; with stay_stable (lambda stable at the speed) a step that would leave the
- * side where the model is stable is halved until it does not. */
+/* The last conicity on the way from lambda (stable at the speed) to lambda + step (not) where the model is still
+ * stable: bisection to a relative width of HM_MODE_MODEL_EDGE_RTOL. */
+static double stable_edge(hm_mode_model m, double lambda, double step, double v_kmh) {
+  double in = lambda, out = lambda + step;
+  while (fabs(out - in) > HM_MODE_MODEL_EDGE_RTOL * fabs(in)) {
+    const double mid = 0.5 * (in + out);
+    if (stable_at(m, mid, v_kmh))
+      in = mid;
+    else
+      out = mid;
+  }
+  return in;
+}
+
+/* The weighted misfit of p from the reference mode. */
+static double misfit(const root_point *p, const ref_mode *ref) {
+  const double r1 = (p->s - ref->sigma) / ref->e_sigma, r2 = (p->w - ref->w) / ref->e_w;
+  return r1 * r1 + r2 * r2;
+}
+
+/* Gauss-Newton on the reading from lambda, damped: a step to where the misfit grows or the reading fails is halved
+ * from the point before it (the reading is far from linear in the conicity near a stability edge, where its decay
+ * rate runs into 0, and a full step there oscillates). With stay_stable (lambda stable at the speed) it is projected
+ * onto the conicities where the model is stable: a step that would leave them ends at their edge (stable_edge), and
+ * a step so clipped below the tolerance ends the search there (the nearest a stable model comes to the reading). */
 static hm_status gauss_newton_reading(hm_mode_model m, unsigned poles, double speed_kmh, const ref_mode *ref,
                                       double lambda, int stay_stable, double tol, unsigned max_iter,
                                       hm_conicity_inversion *out) {
-  double th1[NPM], th2[NPM];
+  double th1[NPM], th2[NPM], prev = NAN, prev_chi2 = INFINITY, prev_step = 0.0;
+  root_point prev_p = {0};
   int have = 0;
   for (unsigned it = 1; it <= max_iter; ++it) {
     root_point p;
-    if (reading_with_slope(m, poles, lambda, speed_kmh, ref, th1, th2, &have, &p) != HM_OK) return HM_ENOCONV;
-    double step;
-    if (!gauss_newton_step(&p, lambda, ref->sigma, ref->e_sigma, ref->w, ref->e_w, &step)) return HM_ENOCONV;
-    if (fabs(step) > tol * fmax(lambda, 1.0)) {
-      for (int k = 0; k < 40 && stay_stable && !stable_at(m, lambda + step, speed_kmh); ++k) step *= 0.5;
-      lambda += step;
+    const int ok = reading_with_slope(m, poles, lambda, speed_kmh, ref, th1, th2, &have, &p) == HM_OK;
+    if (!ok && !isfinite(prev)) return HM_ENOCONV;
+    if (isfinite(prev) && (!ok || !(misfit(&p, ref) <= prev_chi2))) { /* back to the point before, half the step */
+      prev_step *= 0.5;
+      if (fabs(prev_step) <= tol * fmax(prev, 1.0)) {
+        inversion_result(&prev_p, prev, ref->sigma, ref->e_sigma, ref->w, ref->e_w, it, out);
+        return HM_OK;
+      }
+      lambda = prev + prev_step;
       continue;
     }
-    if (!(lambda > 0.0 && lambda < 10.0)) return HM_ENOCONV;
-    inversion_result(&p, lambda, ref->sigma, ref->e_sigma, ref->w, ref->e_w, it, out);
-    return HM_OK;
+    double step;
+    if (!gauss_newton_step(&p, lambda, ref->sigma, ref->e_sigma, ref->w, ref->e_w, &step)) return HM_ENOCONV;
+    const double eps = tol * fmax(lambda, 1.0);
+    if (fabs(step) > eps && stay_stable && !stable_at(m, lambda + step, speed_kmh))
+      step = stable_edge(m, lambda, step, speed_kmh) - lambda;
+    if (fabs(step) <= eps) {
+      if (!(lambda > 0.0 && lambda < 10.0)) return HM_ENOCONV;
+      inversion_result(&p, lambda, ref->sigma, ref->e_sigma, ref->w, ref->e_w, it, out);
+      return HM_OK;
+    }
+    prev = lambda, prev_chi2 = misfit(&p, ref), prev_p = p, prev_step = step;
+    lambda += step;
   }
   return HM_ENOCONV;
 }
@@ -401,8 +442,9 @@ hm_status hm_mode_model_invert_reading(hm_mode_model m, unsigned poles, double s
    * Gauss-Newton on the reading. A decaying reading is never explained by a conicity at which the model is unstable
    * at this speed (any root, as the Hopf speed counts the first crossing of any mode: the vehicle ran there without
    * hunting; a bogie's one-pair reading at 523 km/h had been matched to a conicity whose wheelsets' mode grew at
-   * +1.4 1/s, by a stable root's peak beside it): such a result is refused and the search made again from the
-   * nearest scanned conicity where the model is stable, staying on that side. */
+   * +1.4 1/s, by a stable root's peak beside it): the search stays on the stable side (projected, from the nearest
+   * scanned conicity there) unless the nearest scanned conicity of all is unstable and Gauss-Newton from it ends on a
+   * stable one. */
   const double w_m = 2.0 * HM_PI * f_m, e_w = 2.0 * HM_PI * e_f;
   const ref_mode ref = {sigma_m, w_m, e_sigma, e_w};
   double lambda = NAN, best = INFINITY, lambda_st = NAN, best_st = INFINITY, th1[NPM], th2[NPM];
@@ -417,7 +459,7 @@ hm_status hm_mode_model_invert_reading(hm_mode_model m, unsigned poles, double s
   if (!isfinite(lambda)) return HM_ENOCONV;
   tol = fmax(tol, 1e-6);
   hm_conicity_inversion r;
-  if (gauss_newton_reading(m, poles, speed_kmh, &ref, lambda, 0, tol, max_iter, &r) == HM_OK &&
+  if (lambda != lambda_st && gauss_newton_reading(m, poles, speed_kmh, &ref, lambda, 0, tol, max_iter, &r) == HM_OK &&
       stable_at(m, r.conicity, speed_kmh)) {
     *out = r;
     return HM_OK;
