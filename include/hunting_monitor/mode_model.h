@@ -143,6 +143,9 @@ hm_status hm_mode_model_fit_spectrum(hm_mode_model m, double speed_kmh, const hm
 #define HM_MODE_MODEL_READING_ITER 200
 #define HM_MODE_MODEL_READING_SCAN 16   /* conicities 0.02-0.8 (geometric) the reading's inversion starts from */
 #define HM_MODE_MODEL_EDGE_RTOL 1e-9    /* the stability edge's bisection in the conicity (relative) */
+/* the unconstrained pass from an unstable start: where the reading's decay rate sits at 0 (beyond the edge, its slope
+ * 0) the steps oscillate to max_iter (60 in margin.c: 1.2-1.6 s), where a result comes within 3-5 */
+#define HM_MODE_MODEL_UNSTABLE_START_ITER 15
 
 /* The sensor whose reading the model gives ("axlebox", "frame", "carbody" as hm_mode_model_sensor); NULL: none (the
  * inversion by roots). HM_EINVAL for a place the model has not, the sensor unchanged. */
@@ -165,12 +168,17 @@ hm_status hm_mode_model_reading(hm_mode_model m, double conicity, double speed_k
  * precision). A measured (decaying) reading is never explained by a conicity at which the model is unstable at that
  * speed (any root with a real part >= 0, as hm_mode_model_hopf counts the first crossing of any mode: the vehicle ran
  * there without hunting). Gauss-Newton starts from the scanned conicity whose reading is nearest the measured mode;
- * where that conicity is stable, or where Gauss-Newton from an unstable one ends unstable or fails, it runs from the
- * nearest stable one projected onto the stable side: a step that would leave it ends at its edge (bisected to a
- * relative HM_MODE_MODEL_EDGE_RTOL), and a step so clipped below the tolerance ends the search there. Such an edge
- * result (the Hopf speed at the window's speed: the nearest a stable model comes to the reading) is returned with its
- * misfit chi2 for the caller to judge; its slope is a backward difference, the reading's decay rate changing sign
- * across the edge. HM_ENOCONV if no stable conicity is reached. */
+ * where that conicity is unstable it runs unconstrained for at most HM_MODE_MODEL_UNSTABLE_START_ITER steps and its
+ * result is kept if stable; otherwise (and where the nearest scanned conicity is stable) it runs from the nearest
+ * stable one projected onto the stable side: a step that would leave it ends at its edge (bisected to a relative
+ * HM_MODE_MODEL_EDGE_RTOL), and a step so clipped below the tolerance ends the search there. Such an edge result (the
+ * Hopf speed at the window's speed: the nearest a stable model comes to the reading) is returned with its misfit chi2
+ * for the caller to judge; its slope is a backward difference, the reading's decay rate changing sign across the
+ * edge. Both passes are damped: a step to where the misfit grows, the reading fails or the conicity leaves
+ * [HM_MODE_MODEL_LAMBDA_MIN, HM_MODE_MODEL_LAMBDA_MAX] is halved from the point before it (warm from that point's
+ * fits), and where the halved step reaches the tolerance that point is the result (the misfit's minimum along the
+ * step to within it). HM_ENOCONV where no stable conicity in that range is reached, at max_iter, or where the reading
+ * does not change with the conicity. */
 hm_status hm_mode_model_invert_reading(hm_mode_model m, unsigned poles, double speed_kmh, double sigma_m,
                                        double e_sigma, double f_m, double e_f, double tol, unsigned max_iter,
                                        hm_conicity_inversion *out);

@@ -383,6 +383,11 @@ static double stable_edge(hm_mode_model m, double lambda, double step, double v_
   return in;
 }
 
+/* 1 within the conicities the model is evaluated over (its Hopf curve's): a reading's slope below them is noise. */
+static int in_range(double lambda) {
+  return lambda >= HM_MODE_MODEL_LAMBDA_MIN && lambda <= HM_MODE_MODEL_LAMBDA_MAX;
+}
+
 /* The weighted misfit of p from the reference mode. */
 static double misfit(const root_point *p, const ref_mode *ref) {
   const double r1 = (p->s - ref->sigma) / ref->e_sigma, r2 = (p->w - ref->w) / ref->e_w;
@@ -397,12 +402,13 @@ static double misfit(const root_point *p, const ref_mode *ref) {
 static hm_status gauss_newton_reading(hm_mode_model m, unsigned poles, double speed_kmh, const ref_mode *ref,
                                       double lambda, int stay_stable, double tol, unsigned max_iter,
                                       hm_conicity_inversion *out) {
-  double th1[NPM], th2[NPM], prev = NAN, prev_chi2 = INFINITY, prev_step = 0.0;
+  double th1[NPM], th2[NPM], pth1[NPM], pth2[NPM], prev = NAN, prev_chi2 = INFINITY, prev_step = 0.0;
   root_point prev_p = {0};
-  int have = 0;
+  int have = 0, phave = 0;
   for (unsigned it = 1; it <= max_iter; ++it) {
     root_point p;
-    const int ok = reading_with_slope(m, poles, lambda, speed_kmh, ref, th1, th2, &have, &p) == HM_OK;
+    if (!in_range(lambda) && !isfinite(prev)) return HM_ENOCONV;
+    const int ok = in_range(lambda) && reading_with_slope(m, poles, lambda, speed_kmh, ref, th1, th2, &have, &p) == HM_OK;
     if (!ok && !isfinite(prev)) return HM_ENOCONV;
     if (isfinite(prev) && (!ok || !(misfit(&p, ref) <= prev_chi2))) { /* back to the point before, half the step */
       prev_step *= 0.5;
@@ -411,6 +417,7 @@ static hm_status gauss_newton_reading(hm_mode_model m, unsigned poles, double sp
         return HM_OK;
       }
       lambda = prev + prev_step;
+      memcpy(th1, pth1, sizeof th1), memcpy(th2, pth2, sizeof th2), have = phave; /* warm from the point before */
       continue;
     }
     double step;
@@ -419,11 +426,11 @@ static hm_status gauss_newton_reading(hm_mode_model m, unsigned poles, double sp
     if (fabs(step) > eps && stay_stable && !stable_at(m, lambda + step, speed_kmh))
       step = stable_edge(m, lambda, step, speed_kmh) - lambda;
     if (fabs(step) <= eps) {
-      if (!(lambda > 0.0 && lambda < 10.0)) return HM_ENOCONV;
       inversion_result(&p, lambda, ref->sigma, ref->e_sigma, ref->w, ref->e_w, it, out);
       return HM_OK;
     }
     prev = lambda, prev_chi2 = misfit(&p, ref), prev_p = p, prev_step = step;
+    memcpy(pth1, th1, sizeof th1), memcpy(pth2, th2, sizeof th2), phave = have;
     lambda += step;
   }
   return HM_ENOCONV;
@@ -436,7 +443,7 @@ hm_status hm_mode_model_invert_reading(hm_mode_model m, unsigned poles, double s
   if (poles != 1 && poles != 2) return HM_EDOMAIN;
   if (!m->have_sensor) return hm_mode_model_invert(m, speed_kmh, sigma_m, e_sigma, f_m, e_f, tol, max_iter, out);
   if (!inputs_ok(speed_kmh, e_sigma, e_f) || !(sigma_m < 0.0) || !isfinite(sigma_m) || !(f_m > 0.0 && f_m < 1e3) ||
-      !(tol > 0.0) || max_iter < 1)
+      !(tol > 0.0) || !isfinite(tol) || max_iter < 1)
     return HM_EDOMAIN;
   /* the start: the scanned conicity whose reading (the peak the measured mode lies on) is nearest it, then
    * Gauss-Newton on the reading. A decaying reading is never explained by a conicity at which the model is unstable
@@ -459,7 +466,8 @@ hm_status hm_mode_model_invert_reading(hm_mode_model m, unsigned poles, double s
   if (!isfinite(lambda)) return HM_ENOCONV;
   tol = fmax(tol, 1e-6);
   hm_conicity_inversion r;
-  if (lambda != lambda_st && gauss_newton_reading(m, poles, speed_kmh, &ref, lambda, 0, tol, max_iter, &r) == HM_OK &&
+  const unsigned first_iter = max_iter < HM_MODE_MODEL_UNSTABLE_START_ITER ? max_iter : HM_MODE_MODEL_UNSTABLE_START_ITER;
+  if (lambda != lambda_st && gauss_newton_reading(m, poles, speed_kmh, &ref, lambda, 0, tol, first_iter, &r) == HM_OK &&
       stable_at(m, r.conicity, speed_kmh)) {
     *out = r;
     return HM_OK;
