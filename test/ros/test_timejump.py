@@ -119,7 +119,9 @@ class TimeJump(unittest.TestCase):
         statuses, diags = self.since(mark)
         self.assert_monitoring_again(statuses, 509.0, 3.5)
         last = statuses[-1]
-        self.assertTrue(0.58 <= last.sensor_clock_offset_s < 0.65, last.sensor_clock_offset_s)
+        # the node's clock may lag the stamps by some /clock messages (2 ms each), as in test_1: 18 of them (0.564)
+        # in a fresh-clone run of 2026-12-05 on a loaded VM; 25 allowed, as there
+        self.assertTrue(0.55 <= last.sensor_clock_offset_s < 0.65, last.sensor_clock_offset_s)
         age = (last.header.stamp - last.accel_stamp).to_sec()
         self.assertTrue(-0.01 < age < 0.1, age)
         self.assertTrue(last.oscillation_valid and abs(last.frequency_hz - 14.0) < 0.2, last.frequency_hz)
