@@ -388,12 +388,6 @@ static int in_range(double lambda) {
   return lambda >= HM_MODE_MODEL_LAMBDA_MIN && lambda <= HM_MODE_MODEL_LAMBDA_MAX;
 }
 
-/* The weighted misfit of p from the reference mode. */
-static double misfit(const root_point *p, const ref_mode *ref) {
-  const double r1 = (p->s - ref->sigma) / ref->e_sigma, r2 = (p->w - ref->w) / ref->e_w;
-  return r1 * r1 + r2 * r2;
-}
-
 /* Gauss-Newton on the reading from lambda, damped: a step to where the misfit grows or the reading fails is halved
  * from the point before it (the reading is far from linear in the conicity near a stability edge, where its decay
  * rate runs into 0, and a full step there oscillates). With stay_stable (lambda stable at the speed) it is projected
@@ -407,10 +401,10 @@ static hm_status gauss_newton_reading(hm_mode_model m, unsigned poles, double sp
   int have = 0, phave = 0;
   for (unsigned it = 1; it <= max_iter; ++it) {
     root_point p;
-    if (!in_range(lambda) && !isfinite(prev)) return HM_ENOCONV;
     const int ok = in_range(lambda) && reading_with_slope(m, poles, lambda, speed_kmh, ref, th1, th2, &have, &p) == HM_OK;
     if (!ok && !isfinite(prev)) return HM_ENOCONV;
-    if (isfinite(prev) && (!ok || !(misfit(&p, ref) <= prev_chi2))) { /* back to the point before, half the step */
+    const double chi2 = ok ? ref_distance(ref, p.s, p.w) : INFINITY;
+    if (isfinite(prev) && !(chi2 <= prev_chi2)) { /* back to the point before, half the step */
       prev_step *= 0.5;
       if (fabs(prev_step) <= tol * fmax(prev, 1.0)) {
         inversion_result(&prev_p, prev, ref->sigma, ref->e_sigma, ref->w, ref->e_w, it, out);
@@ -429,7 +423,7 @@ static hm_status gauss_newton_reading(hm_mode_model m, unsigned poles, double sp
       inversion_result(&p, lambda, ref->sigma, ref->e_sigma, ref->w, ref->e_w, it, out);
       return HM_OK;
     }
-    prev = lambda, prev_chi2 = misfit(&p, ref), prev_p = p, prev_step = step;
+    prev = lambda, prev_chi2 = chi2, prev_p = p, prev_step = step;
     memcpy(pth1, th1, sizeof th1), memcpy(pth2, th2, sizeof th2), phave = have;
     lambda += step;
   }
