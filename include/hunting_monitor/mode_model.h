@@ -143,6 +143,13 @@ hm_status hm_mode_model_fit_spectrum(hm_mode_model m, double speed_kmh, const hm
 #define HM_MODE_MODEL_READING_ITER 200
 #define HM_MODE_MODEL_READING_SCAN 16   /* conicities 0.02-0.8 (geometric) the reading's inversion starts from */
 #define HM_MODE_MODEL_EDGE_RTOL 1e-9    /* the stability edge's bisection in the conicity (relative) */
+/* readings the stable pass's start is refined with (golden section over the best scanned conicity's neighbours), the
+ * relative precision its bracket is cut at the stability edges with, and the misfit above which the pass is retried
+ * from that start (the readings' misfit is rough in the conicity: Gauss-Newton from a scanned point ended in local
+ * minima of chi2 4-1600 where another start found the model's own reading to 1e-6) */
+#define HM_MODE_MODEL_START_EVALS 10
+#define HM_MODE_MODEL_START_EDGE_RTOL 1e-4
+#define HM_MODE_MODEL_RETRY_CHI2 1.0
 /* the unconstrained pass from an unstable start: where the reading's decay rate sits at 0 (beyond the edge, its slope
  * 0) the steps oscillate to max_iter (60 in margin.c: 1.2-1.6 s), where a result comes within 3-5 */
 #define HM_MODE_MODEL_UNSTABLE_START_ITER 15
@@ -170,7 +177,9 @@ hm_status hm_mode_model_reading(hm_mode_model m, double conicity, double speed_k
  * there without hunting). Gauss-Newton starts from the scanned conicity whose reading is nearest the measured mode;
  * where that conicity is unstable it runs unconstrained for at most HM_MODE_MODEL_UNSTABLE_START_ITER steps and its
  * result is kept if stable; otherwise (and where the nearest scanned conicity is stable) it runs from the nearest
- * stable one projected onto the stable side: a step that would leave it ends at its edge (bisected to a relative
+ * stable one projected onto the stable side (where that fails, ends at the edge or misfits by chi2 above
+ * HM_MODE_MODEL_RETRY_CHI2, again from that conicity refined by a golden section over its scanned neighbours, cut at
+ * the edges, in HM_MODE_MODEL_START_EVALS readings; the better kept): a step that would leave it ends at its edge (bisected to a relative
  * HM_MODE_MODEL_EDGE_RTOL), and a step so clipped below the tolerance ends the search there. Such an edge result (the
  * Hopf speed at the window's speed: the nearest a stable model comes to the reading) is returned with its misfit chi2
  * for the caller to judge; its slope is a backward difference, the reading's decay rate changing sign across the

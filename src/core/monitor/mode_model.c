@@ -370,10 +370,10 @@ static hm_status reading_with_slope(hm_mode_model m, unsigned poles, double lamb
 }
 
 /* The last conicity on the way from lambda (stable at the speed) to lambda + step (not) where the model is still
- * stable: bisection to a relative width of HM_MODE_MODEL_EDGE_RTOL. */
-static double stable_edge(hm_mode_model m, double lambda, double step, double v_kmh) {
+ * stable: bisection to a relative width of rtol. */
+static double stable_edge(hm_mode_model m, double lambda, double step, double v_kmh, double rtol) {
   double in = lambda, out = lambda + step;
-  while (fabs(out - in) > HM_MODE_MODEL_EDGE_RTOL * fabs(in)) {
+  while (fabs(out - in) > rtol * fabs(in)) {
     const double mid = 0.5 * (in + out);
     if (stable_at(m, mid, v_kmh))
       in = mid;
@@ -386,6 +386,49 @@ static double stable_edge(hm_mode_model m, double lambda, double step, double v_
 /* 1 within the conicities the model is evaluated over (its Hopf curve's): a reading's slope below them is noise. */
 static int in_range(double lambda) {
   return lambda >= HM_MODE_MODEL_LAMBDA_MIN && lambda <= HM_MODE_MODEL_LAMBDA_MAX;
+}
+
+/* The reading's inversion scans these conicities: 0.02..0.8, geometric. */
+static double scan_conicity(int k) { return 0.02 * pow(40.0, (double)k / (HM_MODE_MODEL_READING_SCAN - 1)); }
+
+/* The misfit of the model's (cold) reading nearest the measured mode at lambda; INFINITY where it fails. */
+static double reading_misfit(hm_mode_model m, unsigned poles, double v_kmh, const ref_mode *ref, double lambda) {
+  double th1[NPM], th2[NPM], s, w;
+  if (reading_fit(m, lambda, v_kmh, poles, ref, NULL, NULL, th1, th2, &s, &w) != HM_OK) return INFINITY;
+  return ref_distance(ref, s, w);
+}
+
+/* The stable pass's start: the scan's best stable conicity (index k, misfit d_k) refined by golden section over
+ * its neighbours' span, cut at the stability edge, in HM_MODE_MODEL_START_EVALS readings. The scan's step (28%)
+ * is wider than a precise reading's minimum, and near the edge a reading's decay rate sits at 0 (its root narrower
+ * than the leakage) with no slope to follow: a two-pair reading of -0.73 1/s at 13.88 Hz, 512 km/h, started at the
+ * scanned 0.143 (reading 0, misfit 11) went to the edge at 0.1433 where 0.1316 explains it (misfit 0.81). */
+static double refined_start(hm_mode_model m, unsigned poles, double v_kmh, const ref_mode *ref, int k, double d_k) {
+  double a = k > 0 ? scan_conicity(k - 1) : 0.5 * scan_conicity(0);
+  double b = k + 1 < HM_MODE_MODEL_READING_SCAN ? scan_conicity(k + 1) : 1.5 * scan_conicity(k);
+  const double l_k = scan_conicity(k);
+  /* the bracket cut at the edges only roughly: it is a start, which the projected pass then refines */
+  if (!stable_at(m, b, v_kmh)) b = stable_edge(m, l_k, b - l_k, v_kmh, HM_MODE_MODEL_START_EDGE_RTOL);
+  if (!stable_at(m, a, v_kmh)) a = stable_edge(m, l_k, a - l_k, v_kmh, HM_MODE_MODEL_START_EDGE_RTOL);
+  const double g = 0.5 * (sqrt(5.0) - 1.0);
+  double best_l = l_k, best_d = d_k;
+  double x1 = b - g * (b - a), x2 = a + g * (b - a);
+  double f1 = reading_misfit(m, poles, v_kmh, ref, x1), f2 = reading_misfit(m, poles, v_kmh, ref, x2);
+  for (int e = 2;; ++e) {
+    if (f1 < best_d) best_d = f1, best_l = x1;
+    if (f2 < best_d) best_d = f2, best_l = x2;
+    if (e >= HM_MODE_MODEL_START_EVALS) break;
+    if (f1 <= f2) {
+      b = x2, x2 = x1, f2 = f1;
+      x1 = b - g * (b - a);
+      f1 = reading_misfit(m, poles, v_kmh, ref, x1);
+    } else {
+      a = x1, x1 = x2, f1 = f2;
+      x2 = a + g * (b - a);
+      f2 = reading_misfit(m, poles, v_kmh, ref, x2);
+    }
+  }
+  return best_l;
 }
 
 /* Gauss-Newton on the reading from lambda, damped: a step to where the misfit grows or the reading fails is halved
@@ -418,7 +461,7 @@ static hm_status gauss_newton_reading(hm_mode_model m, unsigned poles, double sp
     if (!gauss_newton_step(&p, lambda, ref->sigma, ref->e_sigma, ref->w, ref->e_w, &step)) return HM_ENOCONV;
     const double eps = tol * fmax(lambda, 1.0);
     if (fabs(step) > eps && stay_stable && !stable_at(m, lambda + step, speed_kmh))
-      step = stable_edge(m, lambda, step, speed_kmh) - lambda;
+      step = stable_edge(m, lambda, step, speed_kmh, HM_MODE_MODEL_EDGE_RTOL) - lambda;
     if (fabs(step) <= eps) {
       inversion_result(&p, lambda, ref->sigma, ref->e_sigma, ref->w, ref->e_w, it, out);
       return HM_OK;
@@ -448,14 +491,12 @@ hm_status hm_mode_model_invert_reading(hm_mode_model m, unsigned poles, double s
    * stable one. */
   const double w_m = 2.0 * HM_PI * f_m, e_w = 2.0 * HM_PI * e_f;
   const ref_mode ref = {sigma_m, w_m, e_sigma, e_w};
-  double lambda = NAN, best = INFINITY, lambda_st = NAN, best_st = INFINITY, th1[NPM], th2[NPM];
+  double lambda = NAN, best = INFINITY, lambda_st = NAN, best_st = INFINITY;
+  int k_st = -1;
   for (int k = 0; k < HM_MODE_MODEL_READING_SCAN; ++k) {
-    const double l = 0.02 * pow(40.0, (double)k / (HM_MODE_MODEL_READING_SCAN - 1)); /* 0.02..0.8, geometric */
-    double s, w;
-    if (reading_fit(m, l, speed_kmh, poles, &ref, NULL, NULL, th1, th2, &s, &w) != HM_OK) continue;
-    const double d = ref_distance(&ref, s, w);
+    const double l = scan_conicity(k), d = reading_misfit(m, poles, speed_kmh, &ref, l);
     if (d < best) best = d, lambda = l;
-    if (d < best_st && stable_at(m, l, speed_kmh)) best_st = d, lambda_st = l;
+    if (d < best_st && stable_at(m, l, speed_kmh)) best_st = d, lambda_st = l, k_st = k;
   }
   if (!isfinite(lambda)) return HM_ENOCONV;
   tol = fmax(tol, 1e-6);
@@ -466,10 +507,20 @@ hm_status hm_mode_model_invert_reading(hm_mode_model m, unsigned poles, double s
     *out = r;
     return HM_OK;
   }
-  if (!isfinite(lambda_st) ||
-      gauss_newton_reading(m, poles, speed_kmh, &ref, lambda_st, 1, tol, max_iter, &r) != HM_OK ||
-      !stable_at(m, r.conicity, speed_kmh))
-    return HM_ENOCONV;
+  if (k_st < 0) return HM_ENOCONV;
+  /* from the scanned start; where that fails, ends at the edge (the nearest a stable model comes, or a start where
+   * the reading sat flat at 0) or misfits by more than HM_MODE_MODEL_RETRY_CHI2 (a local minimum), again from the
+   * refined start, the better kept */
+  int ok = gauss_newton_reading(m, poles, speed_kmh, &ref, lambda_st, 1, tol, max_iter, &r) == HM_OK &&
+           stable_at(m, r.conicity, speed_kmh);
+  if (!ok || r.chi2 > HM_MODE_MODEL_RETRY_CHI2 || !stable_at(m, r.conicity * (1.0 + 1e-6), speed_kmh)) {
+    hm_conicity_inversion r2;
+    const double l2 = refined_start(m, poles, speed_kmh, &ref, k_st, best_st);
+    if (gauss_newton_reading(m, poles, speed_kmh, &ref, l2, 1, tol, max_iter, &r2) == HM_OK &&
+        stable_at(m, r2.conicity, speed_kmh) && (!ok || r2.chi2 < r.chi2))
+      r = r2, ok = 1;
+  }
+  if (!ok) return HM_ENOCONV;
   *out = r;
   return HM_OK;
 }
