@@ -38,8 +38,8 @@
  *    its F; and every other lone candidate outside the mode's peak (three half-widths, two frequency errors) is left
  *    out of the fit when the reading is not line-narrow (a 20.8 Hz slab line sweeping 0.3 Hz beside a mode of -3.5
  *    1/s at 14.1 Hz had read it as -1.5: test_modal).
- *  - A reading is valid when converged, lightly damped (damping ratio below 0.5), a peak (over min_peak_to_mean, 3,
- *    times the band's mean, and ln(bins) more over the few bins a narrow one covers: the largest of 650 chance ordinates reaches 6.5),
+ *  - A reading is valid when converged, lightly damped (damping ratio below 0.5), a peak (over 3 times the band's
+ *    mean, and ln(bins) more over the few bins a narrow one covers: the largest of 650 chance ordinates reaches 6.5),
  *    inside the band, and informative (the decay rate's standard error at most HM_MODAL_INFORMATIVE_SE_1_S +
  *    HM_MODAL_INFORMATIVE_REL |sigma|).
  *  - Whittle's log-likelihood  -sum(ln S_k + I_k / S_k)  is maximised by Fisher scoring with Levenberg damping
@@ -89,8 +89,6 @@ typedef struct {
   double line_candidate_ratio;   /* lines.h: a candidate line is this far above its local background */
   double line_min_fundamental_hz;/* lines.h: the comb's lowest spacing [Hz] */
   unsigned line_min_harmonics;   /* lines.h: candidates on a comb needed to declare it */
-  double min_peak_to_mean;       /* a valid reading's peak over the band's mean level (3; a broad mode filling a
-                                    narrow band, a bogie frame's over 5-13 Hz, stays below it: 2) */
 } hm_modal_config;
 
 /* Defaults: 40 s window (fits from 20 s), 100 Hz, band 6-22 Hz, a fit every second, tol 1e-7, 80 steps; lines
@@ -110,7 +108,7 @@ typedef struct {
   double frequency_hz, frequency_se_hz;        /* damped natural frequency w0 / 2 pi */
   double decay_rate_1_s, decay_rate_se_1_s;    /* sigma = -|Re s| [1/s] (negative: decaying) */
   double damping_ratio, damping_ratio_se;      /* -sigma / |s| */
-  double peak_to_mean;         /* the mode's spectral peak over the band's mean level (valid needs > min_peak_to_mean) */
+  double peak_to_mean;         /* the mode's spectral peak over the band's mean level (valid needs > 3) */
   unsigned poles;              /* pole pairs the likelihood chose: 1, or 2 (a second resonance beside the mode) */
   double second_frequency_hz, second_decay_rate_1_s; /* the other pair of two (0 with one) */
   double two_pair_lr;          /* 2 (L1 - L2) over the independent ordinates: two pairs are chosen above
@@ -131,7 +129,7 @@ typedef struct {
   double frequency_hz, frequency_se_hz;        /* damped natural frequency w0 / 2 pi */
   double decay_rate_1_s, decay_rate_se_1_s;    /* sigma = -|Re s| [1/s] (negative: decaying) */
   double damping_ratio, damping_ratio_se;      /* -sigma / |s| */
-  double peak_to_mean;         /* the mode's spectral peak over the band's mean level (valid needs > min_peak_to_mean) */
+  double peak_to_mean;         /* the mode's spectral peak over the band's mean level (valid needs > 3) */
   unsigned iterations;         /* scoring steps of this fit */
   int informative;             /* as in hm_mode_reading */
   unsigned poles;              /* as in hm_mode_reading */

@@ -506,7 +506,6 @@ static const settings_field modal_fields[] = {
     MOD(tol, FIELD_DOUBLE),            MOD(max_iter, FIELD_UNSIGNED),
     MOD(reject_lines, FIELD_BOOL),     MOD(line_candidate_ratio, FIELD_DOUBLE),
     MOD(line_min_fundamental_hz, FIELD_DOUBLE), MOD(line_min_harmonics, FIELD_UNSIGNED),
-    MOD(min_peak_to_mean, FIELD_DOUBLE),
 };
 
 static const settings_field margin_fields[] = {

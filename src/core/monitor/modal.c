@@ -73,7 +73,6 @@ void hm_modal_config_default(hm_modal_config *c) {
   c->line_candidate_ratio = lc.candidate_ratio;
   c->line_min_fundamental_hz = lc.min_fundamental_hz;
   c->line_min_harmonics = lc.min_harmonics;
-  c->min_peak_to_mean = 3.0;
 }
 
 /* The line search's settings from the identification's. */
@@ -93,8 +92,7 @@ hm_status hm_modal_config_validate(const hm_modal_config *c, char *why, size_t l
                               {"band_low_hz", c->band_low_hz, HM_RULE_RANGE_OPEN, 2.0, 500.0},
                               {"tol", c->tol, HM_RULE_OPEN, 0.0, 1e-2},
                               {"max_iter", (double)c->max_iter, HM_RULE_RANGE, 1.0, 10000.0},
-                              {"reject_lines", (double)c->reject_lines, HM_RULE_FLAG, 0.0, 0.0},
-                              {"min_peak_to_mean", c->min_peak_to_mean, HM_RULE_RANGE, 1.0, 100.0}};
+                              {"reject_lines", (double)c->reject_lines, HM_RULE_FLAG, 0.0, 0.0}};
   const hm_status st = hm_check_fields(f, HM_COUNT_OF(f), why, len);
   if (st != HM_OK) return st;
   if (!(c->min_window_s >= 2.0 && c->min_window_s <= c->window_s))
@@ -368,12 +366,12 @@ static void reading_of(const hm_modal m, const window_geometry *g, const hm_whit
   r->informative = isfinite(r->decay_rate_se_1_s) &&
                    r->decay_rate_se_1_s <= HM_MODAL_INFORMATIVE_SE_1_S + HM_MODAL_INFORMATIVE_REL * fabs(sg);
   const double margin_hz = 3.0 * r->frequency_se_hz + 2.0 * g->df;
-  /* a peak: over min_peak_to_mean times the band's mean, and for one narrower than a few bins over what the largest of the band's
+  /* a peak: over 3 times the band's mean, and for one narrower than a few bins over what the largest of the band's
    * ordinates reaches by chance (about ln n: the peak's bins, a_e T / pi of them, average that much less) */
   const double cover = fmax(1.0, (-sg + HM_WHITTLE_LEAKAGE / g->T) * g->T / HM_PI);
   r->valid = r->informative && isfinite(r->frequency_se_hz) && r->frequency_hz > m->cfg.band_low_hz + margin_hz &&
              r->frequency_hz < m->cfg.band_high_hz - margin_hz && r->damping_ratio < 0.5 &&
-             r->peak_to_mean > m->cfg.min_peak_to_mean + log((double)d->n) / cover;
+             r->peak_to_mean > 3.0 + log((double)d->n) / cover;
 }
 
 /* An angular frequency [rad/s] inside the band. */

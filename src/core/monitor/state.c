@@ -98,8 +98,7 @@ uint64_t hm_state_hash(const hm_monitor_config *cfg, const hm_vehicle *veh) {
   }
   const hm_modal_config *md = &cfg->modal;
   const double mv[] = {md->window_s, md->min_window_s, md->decimated_rate_hz, md->band_low_hz, md->band_high_hz,
-                       md->fit_interval_s, md->tol, md->line_candidate_ratio, md->line_min_fundamental_hz,
-                       md->min_peak_to_mean};
+                       md->fit_interval_s, md->tol, md->line_candidate_ratio, md->line_min_fundamental_hz};
   for (size_t k = 0; k < sizeof mv / sizeof mv[0]; ++k) h = fnv_f64(h, mv[k]);
   h = fnv_u64(h, md->max_iter);
   h = fnv_u64(h, (uint64_t)(int64_t)md->reject_lines);
