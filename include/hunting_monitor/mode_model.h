@@ -127,7 +127,8 @@ hm_status hm_mode_model_fit_spectrum(hm_mode_model m, double speed_kmh, const hm
  * HM_MODE_MODEL_READING_DF_HZ (wider where the band needs more than HM_MODE_MODEL_READING_MAX_BINS), its poles moved left by the leakage of a HM_MODE_MODEL_READING_WINDOW_S window and the fit
  * told that window (whittle.h's leakage, so that the reading is the pole pair's own; a peak sharper than the bins
  * would leave the fit rough), started from three widths at the peak and from every root in the band (the best likelihood kept), or within an
- * inversion from the measured mode and from the peak (the one nearest the measured mode kept); a fit counts as a mode
+ * inversion from the measured mode and from the peak (the one nearest the measured mode kept; two pairs: of the two
+ * splits of that pair's peak the one of least objective, as modal.c keeps); a fit counts as a mode
  * when its damping ratio is below HM_MODE_MODEL_READING_MAX_ZETA and its peak above HM_MODE_MODEL_READING_MIN_PEAK
  * times the band's mean; the pair the monitor takes for the mode (the less damped of
  * two). Inverting the measured reading against it (hm_mode_model_invert_reading) compares like with like: on the

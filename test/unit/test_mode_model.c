@@ -550,6 +550,38 @@ static void readings_off_the_model_frequency(void) {
   hm_modal_destroy(modal);
 }
 
+/* Windows measured on the default bogie's axle box (evaluate_vehicle's default_axlebox_5: `hunting simulate` of
+ * config/bogie_default.yaml at conicity 0.15, 410.1 km/h, 100 km/h below its Hopf speed; two pole pairs, the mode at
+ * 14.2 Hz beside a broader one at 16.5), each with margin.c's errors (its standard errors with the model's 5% + 1 / T of
+ * the decay rate and 1% of the frequency). The reference is the simulation's conicity: each window's interval (2
+ * standard errors) must hold it. The model's two-pair reading had been chosen nearest the measured mode among the
+ * fits of two splits of its peak: it jumped from one decomposition to the other with the conicity, and at 0.1875-0.19
+ * one sat on the measured mode, an island of 0.003 whose slope gave 0.1953 +- 0.0073 (the monitor's estimate then
+ * showed a Hopf speed 70 km/h low and a WARN 80 km/h below the truth). */
+static void measured_windows_of_the_bogie(void) {
+  static const struct {
+    double sigma, sigma_se, f, f_se;
+  } c[] = {{-3.49, 0.94, 14.175, 0.097}, {-3.64, 0.91, 14.249, 0.093}, {-3.84, 0.88, 14.274, 0.091}};
+  const double v_kmh = 410.1, truth = 0.15, window_s = 40.0;
+  hm_monitor_config cfg;
+  hm_monitor_config_default(&cfg);
+  hm_modal modal = NULL;
+  HM_CHECK(hm_modal_create(&cfg.modal, 500.0, &modal, NULL, 0) == HM_OK, "the monitor's filters at 500 Hz");
+  hm_mode_model m = reading_model(HM_MODEL_BOGIE, 0.0, "axlebox", 0.0, 0.0, &cfg, modal);
+  for (size_t i = 0; m && i < sizeof c / sizeof c[0]; ++i) {
+    const double e_sigma = hypot(c[i].sigma_se, 0.05 * fabs(c[i].sigma) + 1.0 / window_s);
+    const double e_f = hypot(c[i].f_se, 0.01 * c[i].f);
+    hm_conicity_inversion inv;
+    memset(&inv, 0, sizeof inv);
+    const hm_status st = hm_mode_model_invert_reading(m, 2, v_kmh, c[i].sigma, e_sigma, c[i].f, e_f, 1e-9, 60, &inv);
+    printf("  %.2f 1/s at %.3f Hz: status %d, conicity %.4f +- %.4f, chi2 %.3g (simulated %.2f)\n", c[i].sigma, c[i].f,
+           (int)st, inv.conicity, inv.conicity_se, inv.chi2, truth);
+    HM_CHECK(st == HM_OK && fabs(inv.conicity - truth) <= 2.0 * inv.conicity_se, "the interval holds the simulation's");
+  }
+  hm_mode_model_destroy(m);
+  hm_modal_destroy(modal);
+}
+
 /* The car's own readings invert back (the forward reading, hm_mode_model_reading, is the reference): the misfit of a
  * reading is rough in the conicity, and Gauss-Newton from the best scanned conicity had ended in a local minimum
  * (a review's round trips of 2026-12-06: chi2 23.2 at 0.3274, 13.3 at 0.1734, 4.45 at 0.2019); the pass is retried
@@ -614,11 +646,16 @@ static void damped_steps_come_back(void) {
     const hm_status st =
         hm_mode_model_invert_reading(m, 2, v, s, hypot(0.15, 0.05 * fabs(s) + 0.1), f, hypot(0.08, 0.01 * f), 1e-9,
                                      60, &inv);
-    printf("  %s %s at %.3f km/h, conicity %.4f: reads %.4f 1/s at %.4f Hz; status %d, conicity %.5f, chi2 %.3g\n",
-           c[i].kind == HM_MODEL_CAR ? "car" : "bogie", c[i].where, v, c[i].lambda, s, f, (int)st, inv.conicity,
-           inv.chi2);
+    printf("  %s %s at %.3f km/h, conicity %.4f: reads %.4f 1/s at %.4f Hz; status %d, conicity %.5f +- %.5f, "
+           "chi2 %.3g\n", c[i].kind == HM_MODEL_CAR ? "car" : "bogie", c[i].where, v, c[i].lambda, s, f, (int)st,
+           inv.conicity, inv.conicity_se, inv.chi2);
     if (c[i].must_invert) HM_CHECK(st == HM_OK, "inverted");
-    if (c[i].must_invert) HM_CHECK(fabs(inv.conicity - c[i].lambda) < 3e-3, "back to the conicity read");
+    /* the car's two-pair reading changes decomposition every 0.002-0.005 in the conicity (a sawtooth of misfits
+     * 0-18 over 0.28-0.30): 0.3's own is an island of 0.001, and a minimum of chi2 0.83 lies at 0.310; either is an
+     * answer, the search's start (0.2991) is not */
+    if (c[i].must_invert)
+      HM_CHECK(inv.chi2 < 1.0 && fabs(inv.conicity - c[i].lambda) < fmax(3e-3, 2.0 * inv.conicity_se),
+               "back to the conicity read: explained, its interval holding it");
     HM_CHECK(st != HM_OK || (inv.conicity >= HM_MODE_MODEL_LAMBDA_MIN && inv.conicity <= HM_MODE_MODEL_LAMBDA_MAX),
              "within the model's conicities");
     hm_conicity_inversion bad;
@@ -644,6 +681,7 @@ int main(void) {
   HM_RUN(readings_near_the_stability_edge);
   HM_RUN(readings_off_the_model_frequency);
   HM_RUN(own_readings_of_the_car_invert_back);
+  HM_RUN(measured_windows_of_the_bogie);
   HM_RUN(damped_steps_come_back);
   HM_RUN(monitor_reads_a_bogie_axle_box);
   HM_RUN(bad_input);
