@@ -41,7 +41,13 @@
  *  - A reading is valid when converged, lightly damped (damping ratio below 0.5), a peak (over 3 times the band's
  *    mean, and ln(bins) more over the few bins a narrow one covers: the largest of 650 chance ordinates reaches 6.5),
  *    inside the band, and informative (the decay rate's standard error at most HM_MODAL_INFORMATIVE_SE_1_S +
- *    HM_MODAL_INFORMATIVE_REL |sigma|).
+ *    HM_MODAL_INFORMATIVE_REL |sigma|). With min_peak_prominence set (0, off, by default), a resonance too broad for
+ *    the band's mean (a_e = |sigma| + 2 / T above B / (6 pi) for a band B rad/s wide: holding half the band's power it
+ *    would stand below 3 times the mean; 2.7 1/s over 5-13 Hz) is a peak too when the fitted spectrum at its frequency
+ *    stands min_peak_prominence (plus the same chance term) times above the larger of its least values below and above
+ *    it (peak_prominence): a bogie frame's 8 Hz mode of -5 to -9 1/s over 5-13 Hz stands 2.1-3.4 times above the
+ *    band's mean and 9-15 times above its sides, while white, 1/f^2 or f^2 noise has no dip on both sides
+ *    (test_modal's a_broad_mode_in_a_narrow_band).
  *  - Whittle's log-likelihood  -sum(ln S_k + I_k / S_k)  is maximised by Fisher scoring with Levenberg damping
  *    (J = d ln S / d theta, step (J'J + mu D)^-1 J'(I/S - 1)), warm-started from the previous fit (a decay rate at
  *    its bound 0 held there: an active set); converged when the objective changes by less than tol relative
@@ -89,6 +95,9 @@ typedef struct {
   double line_candidate_ratio;   /* lines.h: a candidate line is this far above its local background */
   double line_min_fundamental_hz;/* lines.h: the comb's lowest spacing [Hz] */
   unsigned line_min_harmonics;   /* lines.h: candidates on a comb needed to declare it */
+  double min_peak_prominence;    /* 0 (off), or a reading is a peak too when the fitted spectrum at its frequency
+                                    stands this many times above its least values on both sides (peak_prominence):
+                                    a broad mode filling a narrow band, a bogie frame's over 5-13 Hz */
 } hm_modal_config;
 
 /* Defaults: 40 s window (fits from 20 s), 100 Hz, band 6-22 Hz, a fit every second, tol 1e-7, 80 steps; lines
@@ -109,6 +118,9 @@ typedef struct {
   double decay_rate_1_s, decay_rate_se_1_s;    /* sigma = -|Re s| [1/s] (negative: decaying) */
   double damping_ratio, damping_ratio_se;      /* -sigma / |s| */
   double peak_to_mean;         /* the mode's spectral peak over the band's mean level (valid needs > 3) */
+  double peak_prominence;      /* the fitted spectrum at the mode's frequency over the larger of its least values
+                                  below and above it in the band (1 with none on a side); NAN where not measured
+                                  (min_peak_prominence 0, or a reading narrow enough for the band's mean) */
   unsigned poles;              /* pole pairs the likelihood chose: 1, or 2 (a second resonance beside the mode) */
   double second_frequency_hz, second_decay_rate_1_s; /* the other pair of two (0 with one) */
   double two_pair_lr;          /* 2 (L1 - L2) over the independent ordinates: two pairs are chosen above
@@ -130,6 +142,7 @@ typedef struct {
   double decay_rate_1_s, decay_rate_se_1_s;    /* sigma = -|Re s| [1/s] (negative: decaying) */
   double damping_ratio, damping_ratio_se;      /* -sigma / |s| */
   double peak_to_mean;         /* the mode's spectral peak over the band's mean level (valid needs > 3) */
+  double peak_prominence;      /* as in hm_mode_reading */
   unsigned iterations;         /* scoring steps of this fit */
   int informative;             /* as in hm_mode_reading */
   unsigned poles;              /* as in hm_mode_reading */

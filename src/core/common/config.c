@@ -506,6 +506,7 @@ static const settings_field modal_fields[] = {
     MOD(tol, FIELD_DOUBLE),            MOD(max_iter, FIELD_UNSIGNED),
     MOD(reject_lines, FIELD_BOOL),     MOD(line_candidate_ratio, FIELD_DOUBLE),
     MOD(line_min_fundamental_hz, FIELD_DOUBLE), MOD(line_min_harmonics, FIELD_UNSIGNED),
+    MOD(min_peak_prominence, FIELD_DOUBLE),
 };
 
 static const settings_field margin_fields[] = {

@@ -73,6 +73,7 @@ void hm_modal_config_default(hm_modal_config *c) {
   c->line_candidate_ratio = lc.candidate_ratio;
   c->line_min_fundamental_hz = lc.min_fundamental_hz;
   c->line_min_harmonics = lc.min_harmonics;
+  c->min_peak_prominence = 0.0;
 }
 
 /* The line search's settings from the identification's. */
@@ -92,7 +93,8 @@ hm_status hm_modal_config_validate(const hm_modal_config *c, char *why, size_t l
                               {"band_low_hz", c->band_low_hz, HM_RULE_RANGE_OPEN, 2.0, 500.0},
                               {"tol", c->tol, HM_RULE_OPEN, 0.0, 1e-2},
                               {"max_iter", (double)c->max_iter, HM_RULE_RANGE, 1.0, 10000.0},
-                              {"reject_lines", (double)c->reject_lines, HM_RULE_FLAG, 0.0, 0.0}};
+                              {"reject_lines", (double)c->reject_lines, HM_RULE_FLAG, 0.0, 0.0},
+                              {"min_peak_prominence", c->min_peak_prominence, HM_RULE_RANGE, 0.0, 100.0}};
   const hm_status st = hm_check_fields(f, HM_COUNT_OF(f), why, len);
   if (st != HM_OK) return st;
   if (!(c->min_window_s >= 2.0 && c->min_window_s <= c->window_s))
@@ -277,6 +279,7 @@ void hm_mode_estimate_use_reading(hm_mode_estimate *e, const hm_mode_reading *r)
   e->damping_ratio = r->damping_ratio;
   e->damping_ratio_se = r->damping_ratio_se;
   e->peak_to_mean = r->peak_to_mean;
+  e->peak_prominence = r->peak_prominence;
   e->poles = r->poles;
   e->second_frequency_hz = r->second_frequency_hz;
   e->second_decay_rate_1_s = r->second_decay_rate_1_s;
@@ -298,6 +301,7 @@ void hm_mode_estimate_reading(const hm_mode_estimate *e, hm_mode_reading *r) {
   r->damping_ratio = e->damping_ratio;
   r->damping_ratio_se = e->damping_ratio_se;
   r->peak_to_mean = e->peak_to_mean;
+  r->peak_prominence = e->peak_prominence;
   r->poles = e->poles;
   r->second_frequency_hz = e->second_frequency_hz;
   r->second_decay_rate_1_s = e->second_decay_rate_1_s;
@@ -331,6 +335,23 @@ static size_t load_bins(hm_modal m, const window_geometry *g, const unsigned cha
   if (!(*scale > 0.0)) return 0;
   for (size_t k = 0; k < nb; ++k) m->pgram[k] /= *scale;
   return nb;
+}
+
+/* The fitted spectrum's prominence at the mode's w0: S(w0) over the larger of S's least values below and above it
+ * over the fitted bins (1 where either side holds none). A resonance stands above its band on both sides however much
+ * of the band it fills; a rising or falling spectrum (1/f^2 noise, a slope, a pair at the band's edge) has no dip on
+ * one side. */
+static double prominence(const hm_whittle_data *d, const double *th, unsigned poles, const window_geometry *g,
+                         double w0) {
+  double low = INFINITY, high = INFINITY;
+  for (size_t k = 0; k < d->n; ++k) {
+    const double s = hm_whittle_spectrum(th, poles, g->T, d->w[k], d->u[k]);
+    if (d->w[k] < w0) low = fmin(low, s);
+    else high = fmin(high, s);
+  }
+  if (!isfinite(low) || !isfinite(high)) return 1.0;
+  const double top = hm_whittle_spectrum(th, poles, g->T, w0, log(w0 / g->w_ref));
+  return top / fmax(low, high);
 }
 
 /* The reading of a fit theta (poles pairs, Fisher information f): the least-damped pair is the mode. */
@@ -368,10 +389,18 @@ static void reading_of(const hm_modal m, const window_geometry *g, const hm_whit
   const double margin_hz = 3.0 * r->frequency_se_hz + 2.0 * g->df;
   /* a peak: over 3 times the band's mean, and for one narrower than a few bins over what the largest of the band's
    * ordinates reaches by chance (about ln n: the peak's bins, a_e T / pi of them, average that much less) */
-  const double cover = fmax(1.0, (-sg + HM_WHITTLE_LEAKAGE / g->T) * g->T / HM_PI);
+  const double cover = fmax(1.0, (-sg + HM_WHITTLE_LEAKAGE / g->T) * g->T / HM_PI), chance = log((double)d->n) / cover;
+  /* or, with min_peak_prominence set, a resonance too broad for the band's mean: holding half the band's power, a
+   * pair of width a_e stands about B / (2 pi a_e) above the mean of a band B rad/s wide, below 3 for a_e > B / (6 pi)
+   * (2.7 1/s over 5-13 Hz); a narrower peak that fails the mean's test is a minor one (a frame's weak 6.6 Hz peak at
+   * -1 to -2 1/s beside its 8 Hz mode, which the model does not read) */
+  const double band = 2.0 * HM_PI * (m->cfg.band_high_hz - m->cfg.band_low_hz), ae = -sg + HM_WHITTLE_LEAKAGE / g->T;
+  const int broad = m->cfg.min_peak_prominence > 0.0 && band / (2.0 * HM_PI * ae) < 3.0;
+  r->peak_prominence = broad ? prominence(d, th, poles, g, w0) : NAN; /* (a pass over the bins: only where it counts) */
+  const int peak = r->peak_to_mean > 3.0 + chance ||
+                   (broad && r->peak_prominence > m->cfg.min_peak_prominence + chance);
   r->valid = r->informative && isfinite(r->frequency_se_hz) && r->frequency_hz > m->cfg.band_low_hz + margin_hz &&
-             r->frequency_hz < m->cfg.band_high_hz - margin_hz && r->damping_ratio < 0.5 &&
-             r->peak_to_mean > 3.0 + log((double)d->n) / cover;
+             r->frequency_hz < m->cfg.band_high_hz - margin_hz && r->damping_ratio < 0.5 && peak;
 }
 
 /* An angular frequency [rad/s] inside the band. */

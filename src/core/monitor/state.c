@@ -103,6 +103,7 @@ uint64_t hm_state_hash(const hm_monitor_config *cfg, const hm_vehicle *veh) {
   h = fnv_u64(h, md->max_iter);
   h = fnv_u64(h, (uint64_t)(int64_t)md->reject_lines);
   h = fnv_u64(h, md->line_min_harmonics);
+  if (md->min_peak_prominence != 0.0) h = fnv_f64(h, md->min_peak_prominence); /* (off: the hash of before) */
   const hm_margin_config *g = &cfg->margin;
   const double gv[] = {g->frequency_model_error, g->decay_rate_model_error, g->max_speed_spread_kmh,
                        g->min_speed_kmh, g->memory_s, g->min_speed_span_kmh, g->max_extrapolation_kmh,
