@@ -97,6 +97,8 @@ hm_status hm_modal_config_validate(const hm_modal_config *c, char *why, size_t l
                               {"min_peak_prominence", c->min_peak_prominence, HM_RULE_RANGE, 0.0, 100.0}};
   const hm_status st = hm_check_fields(f, HM_COUNT_OF(f), why, len);
   if (st != HM_OK) return st;
+  if (c->min_peak_prominence != 0.0 && c->min_peak_prominence < 2.0) /* (about 1 holds any hump: no test) */
+    return hm_reject(why, len, "min_peak_prominence", "must be 0 (off) or in [2, 100]", c->min_peak_prominence);
   if (!(c->min_window_s >= 2.0 && c->min_window_s <= c->window_s))
     return hm_reject(why, len, "min_window_s", "must be in [2, window_s]", c->min_window_s);
   if (!(c->band_high_hz > c->band_low_hz + 2.0 && c->band_high_hz <= 0.4 * c->decimated_rate_hz))
@@ -338,18 +340,26 @@ static size_t load_bins(hm_modal m, const window_geometry *g, const unsigned cha
 }
 
 /* The fitted spectrum's prominence at the mode's w0: S(w0) over the larger of S's least values below and above it
- * over the fitted bins (1 where either side holds none). A resonance stands above its band on both sides however much
- * of the band it fills; a rising or falling spectrum (1/f^2 noise, a slope, a pair at the band's edge) has no dip on
- * one side. */
+ * over the fitted bins; 1 where either side holds none, or where S rises again towards that side's edge (above
+ * HM_MODAL_PROMINENCE_EDGE_REL times its least value there: another resonance beyond the dip, a wheelset's 14 Hz mode
+ * beside a frame's 8 Hz one, on which the pair reads the mode lighter damped). A resonance stands above its band on
+ * both sides however much of the band it fills; a rising or falling spectrum (1/f^2 noise, a slope, a pair at the
+ * band's edge) has no dip on one side. */
 static double prominence(const hm_whittle_data *d, const double *th, unsigned poles, const window_geometry *g,
                          double w0) {
-  double low = INFINITY, high = INFINITY;
+  double low = INFINITY, high = INFINITY, low_edge = NAN, high_edge = NAN;
   for (size_t k = 0; k < d->n; ++k) {
     const double s = hm_whittle_spectrum(th, poles, g->T, d->w[k], d->u[k]);
-    if (d->w[k] < w0) low = fmin(low, s);
-    else high = fmin(high, s);
+    if (d->w[k] < w0) {
+      low = fmin(low, s);
+      if (isnan(low_edge)) low_edge = s;
+    } else {
+      high = fmin(high, s);
+      high_edge = s;
+    }
   }
   if (!isfinite(low) || !isfinite(high)) return 1.0;
+  if (low_edge > HM_MODAL_PROMINENCE_EDGE_REL * low || high_edge > HM_MODAL_PROMINENCE_EDGE_REL * high) return 1.0;
   const double top = hm_whittle_spectrum(th, poles, g->T, w0, log(w0 / g->w_ref));
   return top / fmax(low, high);
 }
