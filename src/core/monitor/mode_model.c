@@ -724,7 +724,7 @@ static double ref_distance(const ref_mode *ref, double sigma, double w) {
 
 /* The candidate fits of `poles` pairs from starts[0..n): the one nearest ref (in_band), else of least objective. */
 static int choose_fit(const hm_whittle_data *d, unsigned poles, double (*starts)[NPM], int n, const ref_mode *ref,
-                      double w_lo, double w_hi, double *th) {
+                      double w_lo, double w_hi, double w_ref, double *th) {
   double best = INFINITY, fi[NPM][NPM], obj;
   unsigned it;
   int found = 0;
@@ -735,9 +735,10 @@ static int choose_fit(const hm_whittle_data *d, unsigned poles, double (*starts)
     double sg, w;
     pair_of(starts[k], second, &sg, &w);
     if (!(w > w_lo && w < w_hi)) continue;
-    /* a mode as the monitor's validity has it (modal.h): lightly damped, and a peak above the band's mean level */
+    /* a mode as the monitor's validity has it (modal.h): lightly damped, and a peak above the band's mean level (its
+     * numerator taken at its frequency: w_ref is the bins' reference, u = ln(w / w_ref)) */
     if (!(-sg < HM_MODE_MODEL_READING_MAX_ZETA * hypot(sg, w)) ||
-        !(hm_whittle_peak(starts[k], (unsigned)second, d->window_s, w) >= HM_MODE_MODEL_READING_MIN_PEAK))
+        !(hm_whittle_peak(starts[k], (unsigned)second, d->window_s, w_ref) >= HM_MODE_MODEL_READING_MIN_PEAK))
       continue;
     const double score = ref ? ref_distance(ref, sg, w) : obj;
     if (score < best) {
@@ -789,7 +790,7 @@ static hm_status reading_fit(hm_mode_model m, double conicity, double v_kmh, uns
   int found = 0, ns = 0;
   if (warm1) {
     memcpy(starts[0], warm1, sizeof starts[0]);
-    found = choose_fit(&d, 1, starts, 1, NULL, w_lo, w_hi, th1);
+    found = choose_fit(&d, 1, starts, 1, NULL, w_lo, w_hi, w_ref, th1);
   }
   if (!found) {
     /* without a reference: three widths at the spectrum's peak (a smooth peak's fit may settle off it from a narrow
@@ -804,7 +805,7 @@ static hm_status reading_fit(hm_mode_model m, double conicity, double v_kmh, uns
       size_t kr = 0;
       for (size_t k = 1; k < n; ++k)
         if (fabs(m->rd_w[k] - ref->w) < fabs(m->rd_w[kr] - ref->w)) kr = k;
-      const double at = hm_whittle_peak(starts[0], 0, T, ref->w);
+      const double at = hm_whittle_peak(starts[0], 0, T, w_ref);
       if (at > 0.0 && isfinite(at)) starts[0][HM_W_C0] += log(m->rd_p[kr] / at);
       ns = 2; /* and starts[1], the cold one at the peak */
     }
@@ -815,14 +816,14 @@ static hm_status reading_fit(hm_mode_model m, double conicity, double v_kmh, uns
         starts[ns][HM_W_SIGMA] = fmin(re[i], -0.1);
         starts[ns++][HM_W_W0] = im[i];
       }
-    found = choose_fit(&d, 1, starts, ns, poles == 1 ? ref : NULL, w_lo, w_hi, th1);
+    found = choose_fit(&d, 1, starts, ns, poles == 1 ? ref : NULL, w_lo, w_hi, w_ref, th1);
   }
   if (!found) return HM_ENOCRIT;
   const double *th = th1;
   if (poles == 2) {
     ns = 0;
     if (warm2) memcpy(starts[ns++], warm2, sizeof starts[0]);
-    if (!warm2 || !choose_fit(&d, 2, starts, 1, NULL, w_lo, w_hi, th2)) {
+    if (!warm2 || !choose_fit(&d, 2, starts, 1, NULL, w_lo, w_hi, w_ref, th2)) {
       ns = 0;
       hm_whittle_split_start(th1, T, 0.4, starts[ns++]);
       hm_whittle_split_start(th1, T, 0.15, starts[ns++]);
@@ -830,7 +831,7 @@ static hm_status reading_fit(hm_mode_model m, double conicity, double v_kmh, uns
        * jump with the conicity between the two splits' decompositions, and the inversion settle on an island where
        * one happened to sit on the measured mode (the default bogie, 410 km/h, -3.64 1/s at 14.25 Hz: 0.1953 +-
        * 0.0073 from the 0.1875-0.19 island, 0.150 +- 0.026 from the smooth reading; truth 0.15) */
-      if (!choose_fit(&d, 2, starts, ns, NULL, w_lo, w_hi, th2)) return HM_ENOCRIT;
+      if (!choose_fit(&d, 2, starts, ns, NULL, w_lo, w_hi, w_ref, th2)) return HM_ENOCRIT;
     }
     th = th2;
   }
