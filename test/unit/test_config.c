@@ -216,7 +216,7 @@ static void monitor_settings(void) {
       {"estimator:\n  sample_rate_hz: 20\n", "estimator.sample_rate_hz: must be in [100, 5000]", HM_EDOMAIN},
       {"alarm:\n  min_hold_s: -1\n", "alarm.min_hold_s: must be in [0, 3600] (got -1)", HM_EDOMAIN},
       {"modal:\n  window_s: 1000\n", "modal.window_s: must be in [5, 300]", HM_EDOMAIN},
-      {"modal:\n  min_peak_prominence: -1\n", "modal.min_peak_prominence: must be in [0, 100]", HM_EDOMAIN},
+      {"modal:\n  min_peak_prominence: -1\n", "modal.min_peak_prominence: must be 0 (off) or in [2, 100]", HM_EDOMAIN},
       {"modal:\n  min_peak_prominence: 1\n", "modal.min_peak_prominence: must be 0 (off) or in [2, 100]", HM_EDOMAIN},
       {"margin:\n  interval_z: 0\n", "margin.interval_z: must be in [0.5, 10]", HM_EDOMAIN},
       {"track_lines:\n  min_speed_change_rel: 0.01\n", "track_lines.min_speed_change_rel: must be in [0.02, 0.5]",

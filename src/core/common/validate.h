@@ -19,14 +19,15 @@ typedef enum {
   HM_RULE_RANGE = 3,      /* lo <= v <= hi */
   HM_RULE_RANGE_OPEN = 4, /* lo < v <= hi */
   HM_RULE_FLAG = 5,       /* 0 or 1 */
-  HM_RULE_OPEN = 6        /* lo < v < hi */
+  HM_RULE_OPEN = 6,       /* lo < v < hi */
+  HM_RULE_OFF_OR_RANGE = 7 /* 0 (off), or lo <= v <= hi */
 } hm_rule;
 
 typedef struct {
   const char *field; /* the name the user wrote it under, e.g. "bogie.frame_mass_kg" */
   double value;      /* in the unit of that name (MN/m for kx_mn_m) */
   hm_rule rule;
-  double lo, hi; /* a range's ends (HM_RULE_RANGE, HM_RULE_RANGE_OPEN) */
+  double lo, hi; /* a range's ends (HM_RULE_RANGE, HM_RULE_RANGE_OPEN, HM_RULE_OPEN, HM_RULE_OFF_OR_RANGE) */
 } hm_field_check;
 
 static inline hm_status hm_reject(char *why, size_t why_len, const char *field, const char *reason, double got) {
@@ -44,6 +45,7 @@ static inline int hm_field_ok(const hm_field_check *f) {
     case HM_RULE_RANGE_OPEN: return v > f->lo && v <= f->hi;
     case HM_RULE_FLAG: return v == 0.0 || v == 1.0;
     case HM_RULE_OPEN: return v > f->lo && v < f->hi;
+    case HM_RULE_OFF_OR_RANGE: return v == 0.0 || (v >= f->lo && v <= f->hi);
   }
   return 0;
 }
@@ -52,7 +54,8 @@ static inline hm_status hm_check_fields(const hm_field_check *f, size_t n, char 
   for (size_t i = 0; i < n; ++i) {
     if (hm_field_ok(&f[i])) continue;
     /* a range states its ends whatever the value; any other rule, a value that is not finite, says so */
-    const int range = f[i].rule == HM_RULE_RANGE || f[i].rule == HM_RULE_RANGE_OPEN || f[i].rule == HM_RULE_OPEN;
+    const int range = f[i].rule == HM_RULE_RANGE || f[i].rule == HM_RULE_RANGE_OPEN || f[i].rule == HM_RULE_OPEN ||
+                      f[i].rule == HM_RULE_OFF_OR_RANGE;
     char reason[80] = "must be a finite number";
     if (range || isfinite(f[i].value)) switch (f[i].rule) {
         case HM_RULE_POSITIVE: snprintf(reason, sizeof reason, "must be > 0"); break;
@@ -60,6 +63,9 @@ static inline hm_status hm_check_fields(const hm_field_check *f, size_t n, char 
         case HM_RULE_RANGE: snprintf(reason, sizeof reason, "must be in [%g, %g]", f[i].lo, f[i].hi); break;
         case HM_RULE_RANGE_OPEN: snprintf(reason, sizeof reason, "must be in (%g, %g]", f[i].lo, f[i].hi); break;
         case HM_RULE_OPEN: snprintf(reason, sizeof reason, "must be in (%g, %g)", f[i].lo, f[i].hi); break;
+        case HM_RULE_OFF_OR_RANGE:
+          snprintf(reason, sizeof reason, "must be 0 (off) or in [%g, %g]", f[i].lo, f[i].hi);
+          break;
         case HM_RULE_FLAG: snprintf(reason, sizeof reason, "must be 0 or 1"); break;
         case HM_RULE_FINITE: break;
       }

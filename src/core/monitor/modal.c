@@ -94,11 +94,10 @@ hm_status hm_modal_config_validate(const hm_modal_config *c, char *why, size_t l
                               {"tol", c->tol, HM_RULE_OPEN, 0.0, 1e-2},
                               {"max_iter", (double)c->max_iter, HM_RULE_RANGE, 1.0, 10000.0},
                               {"reject_lines", (double)c->reject_lines, HM_RULE_FLAG, 0.0, 0.0},
-                              {"min_peak_prominence", c->min_peak_prominence, HM_RULE_RANGE, 0.0, 100.0}};
+                              /* (about 1 holds any hump: no test) */
+                              {"min_peak_prominence", c->min_peak_prominence, HM_RULE_OFF_OR_RANGE, 2.0, 100.0}};
   const hm_status st = hm_check_fields(f, HM_COUNT_OF(f), why, len);
   if (st != HM_OK) return st;
-  if (c->min_peak_prominence != 0.0 && c->min_peak_prominence < 2.0) /* (about 1 holds any hump: no test) */
-    return hm_reject(why, len, "min_peak_prominence", "must be 0 (off) or in [2, 100]", c->min_peak_prominence);
   if (!(c->min_window_s >= 2.0 && c->min_window_s <= c->window_s))
     return hm_reject(why, len, "min_window_s", "must be in [2, window_s]", c->min_window_s);
   if (!(c->band_high_hz > c->band_low_hz + 2.0 && c->band_high_hz <= 0.4 * c->decimated_rate_hz))
@@ -385,7 +384,7 @@ static void reading_of(const hm_modal m, const window_geometry *g, const hm_whit
   r->second_decay_rate_1_s = poles == 2 ? -fabs(th[second ? HM_W_SIGMA : HM_W_SIGMA2]) : 0.0;
   /* the peak's core (within half its width a_e of w0): sum (I/S - 1) over its bins, standardised (a padded bin
    * counts 1 / padding); a narrower resonance inside the pair's fitted peak leaves an excess there */
-  const double half = 0.5 * (-sg + HM_WHITTLE_LEAKAGE / g->T);
+  const double ae = -sg + HM_WHITTLE_LEAKAGE / g->T, half = 0.5 * ae; /* the pair's width with the leakage */
   double sum = 0.0;
   size_t n_core = 0;
   for (size_t k = 0; k < d->n; ++k)
@@ -399,12 +398,12 @@ static void reading_of(const hm_modal m, const window_geometry *g, const hm_whit
   const double margin_hz = 3.0 * r->frequency_se_hz + 2.0 * g->df;
   /* a peak: over 3 times the band's mean, and for one narrower than a few bins over what the largest of the band's
    * ordinates reaches by chance (about ln n: the peak's bins, a_e T / pi of them, average that much less) */
-  const double cover = fmax(1.0, (-sg + HM_WHITTLE_LEAKAGE / g->T) * g->T / HM_PI), chance = log((double)d->n) / cover;
+  const double cover = fmax(1.0, ae * g->T / HM_PI), chance = log((double)d->n) / cover;
   /* or, with min_peak_prominence set, a resonance too broad for the band's mean: holding half the band's power, a
    * pair of width a_e stands about B / (2 pi a_e) above the mean of a band B rad/s wide, below 3 for a_e > B / (6 pi)
    * (2.7 1/s over 5-13 Hz); a narrower peak that fails the mean's test is a minor one (a frame's weak 6.6 Hz peak at
    * -1 to -2 1/s beside its 8 Hz mode, which the model does not read) */
-  const double band = 2.0 * HM_PI * (m->cfg.band_high_hz - m->cfg.band_low_hz), ae = -sg + HM_WHITTLE_LEAKAGE / g->T;
+  const double band = 2.0 * HM_PI * (m->cfg.band_high_hz - m->cfg.band_low_hz);
   const int broad = m->cfg.min_peak_prominence > 0.0 && band / (2.0 * HM_PI * ae) < 3.0;
   r->peak_prominence = broad ? prominence(d, th, poles, g, w0) : NAN; /* (a pass over the bins: only where it counts) */
   const int peak = r->peak_to_mean > 3.0 + chance ||
