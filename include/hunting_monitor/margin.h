@@ -104,10 +104,14 @@ typedef struct {
   double interval_z;             /* intervals are +- this many standard errors */
   double max_misfit_chi2;        /* a window the model explains worse than this (chi2, 1 dof) is a misfit */
   double change_z;               /* a window this many combined standard errors from the mean is a change */
+  /* with a vehicle model (hm_margin_set_model): a window's conicity from the model's whole spectrum at the sensor over
+   * this band [Hz] (spectrum_fit.h; both 0: off, the mode's reading inverted), with a relative systematic error */
+  double spectrum_low_hz, spectrum_high_hz;
+  double spectrum_model_error;
 } hm_margin_config;
 
 /* Defaults: 1%, 5%, 12 km/h, 200 km/h, 900 s, 20 km/h, 150 km/h, z = 2 (about 95%), misfit chi2 9 (3 standard
- * errors), change at 4 standard errors. */
+ * errors), change at 4 standard errors, the spectrum's conicity off (its error 2% when set). */
 void hm_margin_config_default(hm_margin_config *cfg);
 hm_status hm_margin_config_validate(const hm_margin_config *cfg, char *why, size_t why_len);
 

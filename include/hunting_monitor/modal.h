@@ -202,6 +202,11 @@ typedef struct {
    * less with the speed (0.2-0.3 for the default vehicle, margin.h compares). NAN when not measured (the halves'
    * speeds within HM_MODAL_TRACK_MIN_LOG of each other, or a half's fit failed or left the peak). */
   double speed_tracking, speed_tracking_se;
+  /* set by the caller with a vehicle model (monitor.h; spectrum_fit.h), 0 from the fit: the conicity whose spectrum at
+   * the sensor explains the window's (margin.h's spectrum band), its standard error, the one the model at rest would
+   * have read, and the leading wheelset's rms displacement from the track the fit implies [m] */
+  int spectrum_valid;
+  double spectrum_conicity, spectrum_conicity_se, spectrum_conicity_at_rest, spectrum_motion_rms_m;
 } hm_mode_estimate;
 
 /* The window's halves' speeds must differ by at least this in ln(V2 / V1) for speed_tracking: a line then moves 1% of
@@ -259,6 +264,19 @@ hm_status hm_modal_set_rate(hm_modal m, double sample_rate_hz);
 /* |H(f)|^2 of the filters before the window (the high- and low-pass above) at the current input rate, for f_hz [Hz]
  * (NAN for a negative or non-finite one); modal is an hm_modal (void: mode_model.h's gain callback). */
 double hm_modal_filter_power_gain(const void *modal, double f_hz);
+
+/* The power gain below which a bin is left out of hm_modal_window_spectrum (the filters' stopband: dividing it out
+ * would raise the sensor's noise there 1000-fold). */
+#define HM_MODAL_SPECTRUM_MIN_GAIN 1e-3
+
+/* The last fit's window (the whole window hm_modal_fit read, after its lines were set aside): its periodogram over
+ * [low_hz, high_hz] without the bins set aside for lines, as the sensor's two-sided acceleration density [(m/s^2)^2 /
+ * Hz] (|X_k|^2 / (n fd), the filters' power gain divided out; bins below HM_MODAL_SPECTRUM_MIN_GAIN left out), at most
+ * cap bins into f_hz[] and psd[]; *n the bins, *dof each one's degrees of freedom (2 n / nfft: the zero padding's
+ * bins are not independent), *window_s the window's length [s]. HM_EDOMAIN for a band outside (0, fd / 2),
+ * HM_ENOCONV where no window is kept (no fit yet, or since a reset) or the band holds fewer than 8 bins. */
+hm_status hm_modal_window_spectrum(const hm_modal m, double low_hz, double high_hz, double *f_hz, double *psd,
+                                   size_t cap, size_t *n, double *dof, double *window_s);
 
 /* One acceleration sample [m/s^2] at the input rate (finite: the caller validates). */
 void hm_modal_push(hm_modal m, double accel_mps2);

@@ -103,18 +103,28 @@ hm_status hm_mode_model_sensor(hm_mode_model m, const char *where, hm_sensor_poi
 hm_status hm_mode_model_sensor_spectrum(hm_mode_model m, double conicity, double speed_kmh,
                                         const hm_sensor_point *point, const double *f_hz, size_t n, double *shape);
 
+/* The running state the spectrum is linearised about: the periodogram's window (each pole widened by its leakage,
+ * 2 / window_s, as the identification's fit takes a window's leakage, whittle.h; 0: none) and each wheelset's rms displacement
+ * from the track [m] (0: at rest; otherwise Gaussian equivalent linearisation: the wheel-rail terms' mean slope over
+ * that motion, which for MODEL.md's flange force alpha1 r^3 + alpha2 r^5 is 3 alpha1 s^2 + 15 alpha2 s^4; lambda(y)
+ * enters likewise). Leading wheelset first, as the system's. */
 typedef struct {
-  double conicity, conicity_se;  /* the likelihood's minimum and its curvature's error */
-  double amplitude, noise;       /* the shape's factor and the white floor [(m/s^2)^2 / Hz] */
-  double neg2_log_lik;           /* -2 log L at the minimum (up to a constant) */
-} hm_spectrum_fit;
+  double window_s;
+  double motion_rms_m[HM_SYSTEM_MAX_WHEELSETS];
+} hm_running;
 
-/* The conicity whose predicted spectrum a psd + n explains best: the Whittle likelihood of a measured spectrum psd[]
- * at f_hz[] (each bin the mean of dof / 2 independent periodograms), amplitude a and floor n profiled out (a grid of
- * 30 floors, Newton on a), over [lo, hi]: a geometric scan of 24 conicities, then golden section to tol. */
-hm_status hm_mode_model_fit_spectrum(hm_mode_model m, double speed_kmh, const hm_sensor_point *point,
-                                     const double *f_hz, const double *psd, size_t n, double dof, double lo,
-                                     double hi, double tol, hm_spectrum_fit *out);
+/* The shape at n frequencies (as hm_mode_model_sensor_spectrum) about a running state. HM_EDOMAIN for a window below 0
+ * or a motion below 0 or not finite. */
+hm_status hm_mode_model_running_spectrum(hm_mode_model m, double conicity, double speed_kmh,
+                                         const hm_sensor_point *point, const hm_running *run, const double *f_hz,
+                                         size_t n, double *shape);
+
+/* Each wheelset's rms displacement from the track [m] (motion_rms_m[0..n_wheelsets-1]) when the track's spectrum is
+ * `amplitude` times the shape's (the factor a fit of the shape to a measured two-sided density finds, spectrum_fit.h):
+ * 2 a times the integral over f > 0 of |R_i(f)|^2 S(2 pi f / v) / v, R_i the transfer from the track to wheelset i's
+ * displacement from it, over the track's wavelengths 1-200 m (400 points geometric in f), linearised about run. */
+hm_status hm_mode_model_motion_rms(hm_mode_model m, double conicity, double speed_kmh, const hm_running *run,
+                                   double amplitude, double *motion_rms_m);
 
 /* ---- the monitor's reading on the model ----
  * The monitor reads the hunting mode off the sensor's spectrum as one or two pole pairs over a smooth background

@@ -197,6 +197,13 @@ static void monitor_settings(void) {
   char err[256] = "";
   HM_CHECK(hm_config_load_monitor(HM_SOURCE_DIR "/config/monitor.yaml", &m, err, sizeof err) == HM_OK, "%s", err);
   HM_CHECK(memcmp(&m, &d, sizeof m) == 0, "config/monitor.yaml differs from the defaults");
+  for (int k = 0; k < 2; ++k) { /* the bogie's sensors: the model's spectrum fitted over 6-22 and 4-22 Hz */
+    hm_monitor_config s = d;
+    const char *path = k ? HM_SOURCE_DIR "/config/monitor_bogie_frame.yaml" : HM_SOURCE_DIR "/config/monitor_bogie_axlebox.yaml";
+    HM_CHECK(hm_config_load_monitor(path, &s, err, sizeof err) == HM_OK, "%s", err);
+    HM_CHECK(s.margin.spectrum_low_hz == (k ? 4.0 : 6.0) && s.margin.spectrum_high_hz == 22.0 &&
+                 s.margin.spectrum_model_error == 0.02, "%s: the spectrum's band", path);
+  }
   const char *bogie = "estimator:\n  rms_limit_mps2: 6\n  measurement_point: bogie_frame\n";
   hm_monitor_config b = d;
   HM_CHECK(hm_config_parse_monitor(bogie, strlen(bogie), "b", &b, err, sizeof err) == HM_OK, "%s", err);
@@ -219,6 +226,10 @@ static void monitor_settings(void) {
       {"modal:\n  min_peak_prominence: -1\n", "modal.min_peak_prominence: must be 0 (off) or in [2, 100]", HM_EDOMAIN},
       {"modal:\n  min_peak_prominence: 1\n", "modal.min_peak_prominence: must be 0 (off) or in [2, 100]", HM_EDOMAIN},
       {"margin:\n  interval_z: 0\n", "margin.interval_z: must be in [0.5, 10]", HM_EDOMAIN},
+      {"margin:\n  spectrum_low_hz: 6\n", "margin.spectrum_high_hz: must be 0 with spectrum_low_hz 0", HM_EDOMAIN},
+      {"margin:\n  spectrum_low_hz: 6\n  spectrum_high_hz: 10\n", "else at least twice it (got 10)", HM_EDOMAIN},
+      {"margin:\n  spectrum_low_hz: 0.1\n  spectrum_high_hz: 10\n", "margin.spectrum_low_hz: must be 0 (off) or in",
+       HM_EDOMAIN},
       {"track_lines:\n  min_speed_change_rel: 0.01\n", "track_lines.min_speed_change_rel: must be in [0.02, 0.5]",
        HM_EDOMAIN},
       {"track_lines:\n  wavelength: 0.01\n", "track_lines.wavelength: unknown key", HM_EPARSE},

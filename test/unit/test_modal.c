@@ -735,6 +735,39 @@ static void real_fft_is_the_dft(void) {
          worst_fft);
 }
 
+/* The window's spectrum handed to a model's fit (hm_modal_window_spectrum): white noise of variance s^2 sampled at
+ * fs has the two-sided density s^2 / fs at every frequency, the filters' gain divided out (closed form); its bins at
+ * 2 n / nfft degrees of freedom each; nothing before a fit, a band beyond the decimated Nyquist refused. */
+static void the_window_spectrum_is_a_density(void) {
+  hm_modal_config c;
+  hm_modal_config_default(&c);
+  const double fs = 500.0, sd = 0.3;
+  hm_modal m = NULL;
+  HM_CHECK(hm_modal_create(&c, fs, &m, NULL, 0) == HM_OK, "create");
+  if (!m) return;
+  static double f[2048], p[2048];
+  size_t n = 0;
+  double dof = 0.0, window_s = 0.0;
+  HM_CHECK(hm_modal_window_spectrum(m, 4.0, 22.0, f, p, 2048, &n, &dof, &window_s) == HM_ENOCONV, "no fit: none");
+  hm_test_rng_state = 0x9E3779B97F4A7C15ull;
+  for (long k = 0; k < (long)(40.0 * fs); ++k) hm_modal_push(m, sd * hm_test_gauss());
+  hm_mode_estimate e;
+  HM_CHECK(hm_modal_fit(m, 40.0, 0.0, NAN, &e) == HM_OK, "fit");
+  HM_CHECK(hm_modal_window_spectrum(m, 4.0, 22.0, f, p, 2048, &n, &dof, &window_s) == HM_OK, "the spectrum");
+  double mean = 0.0;
+  for (size_t k = 0; k < n; ++k) mean += p[k];
+  mean /= (double)n;
+  const double expect = sd * sd / fs, rel_se = 1.0 / sqrt(0.5 * dof * (double)n);
+  printf("  white noise: density %.4g over %zu bins (closed form %.4g, +- %.1f%%), %.2f dof a bin, %.1f s\n", mean, n,
+         expect, 100.0 * rel_se, dof, window_s);
+  HM_CHECK(fabs(mean / expect - 1.0) <= 4.0 * rel_se, "the density is s^2 / fs");
+  HM_CHECK(f[0] >= 4.0 && f[n - 1] <= 22.0 && dof > 0.0 && dof <= 2.0 && fabs(window_s - 40.0) < 0.1, "its bins");
+  HM_CHECK(hm_modal_window_spectrum(m, 4.0, 400.0, f, p, 2048, &n, &dof, &window_s) == HM_EDOMAIN, "beyond fd / 2");
+  hm_modal_reset(m);
+  HM_CHECK(hm_modal_window_spectrum(m, 4.0, 22.0, f, p, 2048, &n, &dof, &window_s) == HM_ENOCONV, "reset: none");
+  hm_modal_destroy(m);
+}
+
 int main(void) {
   HM_RUN(a_lone_line_is_not_the_mode);
   HM_RUN(a_line_alone_and_a_narrow_mode);
@@ -749,6 +782,7 @@ int main(void) {
   HM_RUN(coverage_of_the_intervals);
   HM_RUN(coverage_on_misspecified_processes);
   HM_RUN(a_broad_mode_in_a_narrow_band);
+  HM_RUN(the_window_spectrum_is_a_density);
   HM_RUN(bad_configuration);
   HM_TEST_EXIT();
 }

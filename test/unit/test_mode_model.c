@@ -154,99 +154,6 @@ static void band_kink_and_low_speeds(void) {
   hm_mode_model_destroy(m);
 }
 
-/* The spectrum the model predicts at a sensor, fitted to a simulated recording's (the core's sensor simulation of the
- * same model on a random track of the same spectrum): the conicity found again. A bogie's axle box at 440 km/h is
- * where the identification's pole pairs read -1.9..-3.0 1/s for the true -5.95 (docs/VEHICLES.md); the wheelset's at
- * 450 km/h. Welch's periodogram of 4096-sample Hann segments (not overlapping: 2 degrees of freedom each), a DFT at
- * each bin of 6-22 Hz. */
-typedef struct {
-  double *a;
-  size_t n, cap;
-} acc_rec;
-
-static int keep_accel(void *ctx, double t, double measured, double true_accel, const double *x) {
-  (void)t, (void)true_accel, (void)x;
-  acc_rec *r = (acc_rec *)ctx;
-  if (r->n < r->cap) r->a[r->n++] = measured;
-  return 0;
-}
-
-static size_t welch_band(const double *a, size_t n, double fs, double f_lo, double f_hi, double *f, double *p,
-                         double *dof) {
-  enum { SEG = 4096 };
-  const size_t segs = n / SEG;
-  size_t nb = 0;
-  double wsum = 0.0;
-  for (size_t j = 0; j < SEG; ++j) {
-    const double w = 0.5 - 0.5 * cos(2.0 * HM_PI * (double)j / SEG);
-    wsum += w * w;
-  }
-  for (size_t k = (size_t)ceil(f_lo * SEG / fs); (double)k * fs / SEG <= f_hi; ++k) {
-    double acc = 0.0;
-    for (size_t sg = 0; sg < segs; ++sg) {
-      const double *x = a + sg * SEG;
-      double mean = 0.0, re = 0.0, im = 0.0;
-      for (size_t j = 0; j < SEG; ++j) mean += x[j];
-      mean /= SEG;
-      for (size_t j = 0; j < SEG; ++j) {
-        const double w = 0.5 - 0.5 * cos(2.0 * HM_PI * (double)j / SEG), ph = 2.0 * HM_PI * (double)(k * j % SEG) / SEG;
-        re += w * (x[j] - mean) * cos(ph);
-        im -= w * (x[j] - mean) * sin(ph);
-      }
-      acc += (re * re + im * im) / (fs * wsum);
-    }
-    f[nb] = (double)k * fs / SEG;
-    p[nb++] = acc / (double)segs;
-  }
-  *dof = 2.0 * (double)segs;
-  return nb;
-}
-
-static void spectrum_fit_finds_the_conicity(void) {
-  for (int kind = 0; kind < 2; ++kind) {
-    hm_sensor_sim_config c;
-    hm_sensor_sim_config_default(&c);
-    c.v_start_kmh = c.v_end_kmh = kind ? 440.0 : 450.0;
-    c.irregularity_scale = 0.3;
-    c.track_seed = c.noise_seed = 6;
-    c.accel_rate_hz = 500.0;
-    c.accel_noise_mps2 = 0.1;
-    hm_bogie b;
-    hm_bogie_default(&b);
-    hm_bogie_model bm;
-    hm_system sys;
-    hm_mode_model m = NULL;
-    hm_sensor_point point;
-    hm_sensor_sim sim = NULL;
-    HM_CHECK(kind ? hm_mode_model_create_bogie(&b, &m) == HM_OK : hm_mode_model_create_wheelset(&b.wheelset, &m) == HM_OK,
-             "model");
-    HM_CHECK(m && hm_mode_model_sensor(m, "axlebox", &point) == HM_OK, "sensor");
-    if (kind) {
-      HM_CHECK(hm_bogie_model_init(&bm, &b, 0, &sys) == HM_OK, "bogie");
-      HM_CHECK(hm_sensor_sim_create_system(&sys, &point, &c, NULL, &sim, NULL, 0) == HM_OK, "bogie run");
-    } else {
-      HM_CHECK(hm_sensor_sim_create(&b.wheelset, &c, NULL, &sim, NULL, 0) == HM_OK, "wheelset run");
-    }
-    enum { N = 100000 };
-    static double a[N + 1], f[512], p[512];
-    acc_rec r = {a, 0, N + 1};
-    const hm_sensor_sink sink = {keep_accel, NULL, &r};
-    if (sim) HM_CHECK(hm_sensor_sim_run(sim, 200.0, &sink) == HM_OK, "run");
-    hm_sensor_sim_destroy(sim);
-    double dof = 0.0;
-    const size_t nb = welch_band(a + 5000, r.n - 5000, 500.0, 6.0, 22.0, f, p, &dof);
-    hm_spectrum_fit fit;
-    HM_CHECK(m && hm_mode_model_fit_spectrum(m, c.v_start_kmh, &point, f, p, nb, dof, 0.05, 0.4, 1e-5, &fit) == HM_OK,
-             "fit");
-    printf("  %s's axle box at %.0f km/h: the spectrum's fit %.4f +- %.4f (truth 0.1358), %zu bins, %.0f dof\n",
-           kind ? "bogie" : "wheelset", c.v_start_kmh, fit.conicity, fit.conicity_se, nb, dof);
-    HM_CHECK(fabs(fit.conicity - 0.1358) <= fmax(3.0 * fit.conicity_se, 0.002) && fit.conicity_se < 0.01,
-             "the conicity found again");
-    hm_mode_model_destroy(m);
-  }
-}
-
-
 /* The model's reading (mode_model.h) is a fit of the monitor's spectral model to the model's spectrum: on the lone
  * wheelset, whose axle box shows one hunting pair over a smooth background, it is that pair's eigenvalue (dgeev, a
  * second method) to within the background's pull. */
@@ -304,6 +211,19 @@ static void reading_inverts_back(void) {
              "three pairs");
     hm_mode_model_destroy(m);
   }
+}
+
+/* A recording's measured acceleration. */
+typedef struct {
+  double *a;
+  size_t n, cap;
+} acc_rec;
+
+static int keep_accel(void *ctx, double t, double measured, double true_accel, const double *x) {
+  (void)t, (void)true_accel, (void)x;
+  acc_rec *r = (acc_rec *)ctx;
+  if (r->n < r->cap) r->a[r->n++] = measured;
+  return 0;
 }
 
 /* The whole monitor on a bogie's axle box (issue #28): a recording of the default bogie at 480 km/h (sensor_sim.h:
@@ -674,7 +594,6 @@ int main(void) {
   HM_RUN(bogie_and_car_find_their_own_conicity);
   HM_RUN(hopf_curve);
   HM_RUN(band_kink_and_low_speeds);
-  HM_RUN(spectrum_fit_finds_the_conicity);
   HM_RUN(reading_of_the_wheelset_is_its_root);
   HM_RUN(reading_inverts_back);
   HM_RUN(unstable_conicities_explain_no_reading);

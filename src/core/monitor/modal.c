@@ -52,6 +52,9 @@ struct hm_modal_s {
   double *power;               /* |X_k|^2 of every bin (the line search) */
   unsigned char *excluded;     /* the bins of a comb of lines; after it, those set aside before a narrow peak's */
   unsigned char *set_aside;    /* the comb's and the lone lines' */
+  double *spec;                /* the last fit's window: its periodogram (power), the bins set aside for lines, */
+  unsigned char *spec_mask;    /* its samples and FFT length (hm_modal_window_spectrum; spec_n 0: none kept) */
+  size_t spec_n, spec_nfft;
   double *env_work;            /* the narrow peak's envelope (envelope.h) */
   size_t env_work_len;
   hm_lines lines;
@@ -137,6 +140,26 @@ double hm_modal_filter_power_gain(const void *modal, double f_hz) {
   return g * g;
 }
 
+hm_status hm_modal_window_spectrum(const hm_modal m, double low_hz, double high_hz, double *f_hz, double *psd,
+                                   size_t cap, size_t *n, double *dof, double *window_s) {
+  if (!m || !f_hz || !psd || !n || !dof || !window_s) return HM_EINVAL;
+  if (!(low_hz > 0.0) || !(high_hz > low_hz) || !(high_hz < 0.5 * m->fd)) return HM_EDOMAIN;
+  if (m->spec_n == 0) return HM_ENOCONV;
+  const double df = m->fd / (double)m->spec_nfft, norm = (double)m->spec_n * m->fd;
+  size_t nb = 0;
+  for (size_t k = (size_t)ceil(low_hz / df); (double)k * df <= high_hz && k <= m->spec_nfft / 2 && nb < cap; ++k) {
+    const double f = (double)k * df, gain = hm_modal_filter_power_gain(m, f);
+    if (m->spec_mask[k] || !(gain >= HM_MODAL_SPECTRUM_MIN_GAIN) || !(m->spec[k] > 0.0)) continue;
+    f_hz[nb] = f;
+    psd[nb++] = m->spec[k] / norm / gain;
+  }
+  if (nb < 8) return HM_ENOCONV;
+  *n = nb;
+  *dof = 2.0 * (double)m->spec_n / (double)m->spec_nfft;
+  *window_s = (double)m->spec_n / m->fd;
+  return HM_OK;
+}
+
 static void apply_rate(hm_modal m, double fs, unsigned r, double fd) {
   m->fs = fs;
   m->r = r;
@@ -180,6 +203,8 @@ hm_status hm_modal_create(const hm_modal_config *cfg, double fs, hm_modal *out, 
   m->power = malloc((m->nfft_max / 2 + 1) * sizeof(double));
   m->excluded = malloc(m->nfft_max / 2 + 1);
   m->set_aside = malloc(m->nfft_max / 2 + 1);
+  m->spec = malloc((m->nfft_max / 2 + 1) * sizeof(double));
+  m->spec_mask = malloc(m->nfft_max / 2 + 1);
   /* (the decimated rate is below twice the one asked for: rate_plan) */
   m->env_work_len = hm_envelope_work_size(m->cap, 2.0 * cfg->decimated_rate_hz, HM_MODAL_ENVELOPE_BAND_HZ);
   m->env_work = malloc(m->env_work_len * sizeof(double));
@@ -187,7 +212,7 @@ hm_status hm_modal_create(const hm_modal_config *cfg, double fs, hm_modal *out, 
   hm_order_lines_config oc;
   hm_order_lines_config_default(&oc);
   if (!m->ring || !m->speed || !m->x || !m->xv || !m->re || !m->im || !m->cosw || !m->sinw || !m->w || !m->pgram ||
-      !m->u || !m->power || !m->excluded || !m->set_aside || !m->env_work ||
+      !m->u || !m->power || !m->excluded || !m->set_aside || !m->spec || !m->spec_mask || !m->env_work ||
       hm_lines_create(&lc, m->nfft_max / 2 + 1, &m->lines, NULL, 0) != HM_OK ||
       hm_order_lines_create(&oc, &lc, m->cap, m->nfft_max, &m->order, NULL, 0) != HM_OK) {
     hm_modal_destroy(m);
@@ -215,6 +240,8 @@ void hm_modal_destroy(hm_modal m) {
   free(m->u);
   free(m->power);
   free(m->excluded);
+  free(m->spec);
+  free(m->spec_mask);
   free(m->set_aside);
   free(m->env_work);
   hm_lines_destroy(m->lines);
@@ -228,6 +255,7 @@ void hm_modal_reset(hm_modal m) {
   hm_biquad_clear(&m->lp[1]);
   m->phase = 0;
   m->head = m->n_in = m->since_fit = 0; /* (v_now is the caller's: kept) */
+  m->spec_n = 0;
   for (int k = 0; k < 3; ++k) {
     m->warm[k].have1 = m->warm[k].have2 = 0;
     m->warm[k].since_split = HM_MODAL_SPLIT_EVERY - 1; /* the first fit tries the splits */
@@ -945,6 +973,9 @@ hm_status hm_modal_fit(hm_modal m, double max_window_s, double speed_spread_rel,
   for (size_t k = g.k0; k <= g.k1; ++k) ++n_band, n_out += m->set_aside[k] != 0;
   r.band_excluded_fraction = n_band ? (double)n_out / (double)n_band : 0.0;
   memcpy(m->excluded, m->set_aside, m->nfft / 2 + 1); /* the order tracking's bins (centroid) */
+  memcpy(m->spec, m->power, (m->nfft / 2 + 1) * sizeof m->spec[0]); /* the window's spectrum, kept */
+  memcpy(m->spec_mask, m->set_aside, m->nfft / 2 + 1);
+  m->spec_n = n, m->spec_nfft = m->nfft;
   if (narrow >= 0) narrow_peak_readings(m, &g, &fits[narrow], bgs[narrow], n, &r);
   hm_mode_estimate_use_reading(&r, &rd);
   /* order tracking over the whole window (the peak is the same; a ramp's 24 s window alone leaves the halves' slope

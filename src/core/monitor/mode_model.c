@@ -540,17 +540,106 @@ hm_status hm_mode_model_sensor(hm_mode_model m, const char *where, hm_sensor_poi
 }
 
 /* The shape at s = i w + shift: shift > 0 moves every pole left by it (each Lorentzian widened by shift, as a window's
- * leakage does, whittle.h). */
+ * leakage does, whittle.h); linearised at rest (motion NULL) or about the wheelsets' random motion (below); into
+ * shape[], and where motion_out is given, each wheelset's displacement from the track per unit shape factor
+ * (|R_i(w)|^2 S(w / v) / v) into motion_out[i * n + k]. */
 static hm_status sensor_spectrum(hm_mode_model m, double conicity, double speed_kmh, const hm_sensor_point *point,
-                                 const double *f_hz, size_t n, double shift, double *shape);
+                                 const double *f_hz, size_t n, double shift, const double *motion_rms_m,
+                                 double *shape, double *motion_out);
 
 hm_status hm_mode_model_sensor_spectrum(hm_mode_model m, double conicity, double speed_kmh,
                                         const hm_sensor_point *point, const double *f_hz, size_t n, double *shape) {
-  return sensor_spectrum(m, conicity, speed_kmh, point, f_hz, n, 0.0, shape);
+  return sensor_spectrum(m, conicity, speed_kmh, point, f_hz, n, 0.0, NULL, shape, NULL);
+}
+
+/* The running's settings valid: a window of 0 (none) or > 0 s, the wheelsets' motion finite and >= 0. */
+static int running_ok(const hm_mode_model m, const hm_running *run) {
+  if (!run || !(run->window_s >= 0.0) || !isfinite(run->window_s)) return 0;
+  for (size_t i = 0; i < m->sys.n_wheelsets; ++i)
+    if (!(run->motion_rms_m[i] >= 0.0) || !isfinite(run->motion_rms_m[i])) return 0;
+  return 1;
+}
+
+hm_status hm_mode_model_running_spectrum(hm_mode_model m, double conicity, double speed_kmh,
+                                         const hm_sensor_point *point, const hm_running *run, const double *f_hz,
+                                         size_t n, double *shape) {
+  if (!m || !running_ok(m, run)) return HM_EDOMAIN;
+  const double shift = run->window_s > 0.0 ? HM_WHITTLE_LEAKAGE / run->window_s : 0.0;
+  return sensor_spectrum(m, conicity, speed_kmh, point, f_hz, n, shift, run->motion_rms_m, shape, NULL);
+}
+
+/* The track's wavelengths the wheelsets' motion is integrated over [m] (excitation.h's spectrum is fitted for 1-200 m
+ * and the wheelsets follow longer ones: their displacement from the track there is nil) and the grid's points. */
+#define MOTION_WL_MIN_M 1.0
+#define MOTION_WL_MAX_M 200.0
+enum { MOTION_GRID = 400 };
+
+hm_status hm_mode_model_motion_rms(hm_mode_model m, double conicity, double speed_kmh, const hm_running *run,
+                                   double amplitude, double *motion_rms_m) {
+  if (!m || !motion_rms_m || !running_ok(m, run) || !(amplitude >= 0.0) || !isfinite(amplitude)) return HM_EDOMAIN;
+  const double v = hm_mps_from_kmh(speed_kmh);
+  if (!(v > 0.0) || !isfinite(v)) return HM_EDOMAIN;
+  /* a geometric grid in frequency over the wavelengths: the trapezoid rule in ln f (df = f d ln f) */
+  double f[MOTION_GRID], shape[MOTION_GRID], mot[HM_SYSTEM_MAX_WHEELSETS * MOTION_GRID];
+  const double f_lo = v / MOTION_WL_MAX_M, f_hi = v / MOTION_WL_MIN_M, dl = log(f_hi / f_lo) / (MOTION_GRID - 1);
+  for (size_t k = 0; k < MOTION_GRID; ++k) f[k] = f_lo * exp(dl * (double)k);
+  hm_status st = set_conicity(m, conicity);
+  if (st != HM_OK) return st;
+  const hm_sensor_point any = {1, {m->sys.wheelset_y_state[0] + 1}, {1.0}};
+  st = sensor_spectrum(m, conicity, speed_kmh, &any, f, MOTION_GRID, 0.0, run->motion_rms_m, shape, mot);
+  if (st != HM_OK) return st;
+  for (size_t i = 0; i < m->sys.n_wheelsets; ++i) {
+    double var = 0.0;
+    for (size_t k = 0; k < MOTION_GRID; ++k)
+      var += (k == 0 || k == MOTION_GRID - 1 ? 0.5 : 1.0) * mot[i * MOTION_GRID + k] * f[k] * dl;
+    motion_rms_m[i] = sqrt(2.0 * amplitude * var); /* (the density two-sided: both signs of f) */
+  }
+  return HM_OK;
+}
+
+/* Gaussian equivalent linearisation (Roberts and Spanos, Random Vibration and Statistical Linearization, ch. 5): a
+ * wheelset moving about the track as a Gaussian process of rms s sees the wheel-rail terms' mean derivative E[d f /
+ * d r] over r ~ N(0, s^2), not the derivative at rest (the flange force F_T(r) = alpha1 r^3 + alpha2 r^5 of MODEL.md
+ * has none there: its mean slope is 3 alpha1 s^2 + 15 alpha2 s^4). Each wheelset's terms depend on its own r alone, so
+ * the mean of the Jacobian and of the track's input matrix over the 5-point Gauss-Hermite rule, every wheelset at its
+ * own sqrt(2) s_i x_q, is exact for each (F_T' is a polynomial of degree 4; the rule holds to degree 9). */
+static const double GH_X[5] = {-2.020182870456086, -0.958572464613819, 0.0, 0.958572464613819, 2.020182870456086};
+static const double GH_W[5] = {0.019953242059046, 0.393619323152241, 0.945308720482942, 0.393619323152241,
+                               0.019953242059046}; /* (their sum sqrt(pi)) */
+
+/* The Jacobian jac (dim x dim, row-major) and the track's input columns B[i] (d f / d y_track_i) at speed v [m/s],
+ * at rest (motion NULL) or in the mean over the wheelsets' motion (above). */
+static hm_status linearised(const hm_system *sys, double v, const double *motion_rms_m, double *jac,
+                            double (*B)[NMAX]) {
+  const size_t d = sys->dim, nw = sys->n_wheelsets;
+  const int moving = motion_rms_m != NULL;
+  const int nq = moving ? 5 : 1;
+  const double h = 1e-7;
+  memset(jac, 0, d * d * sizeof jac[0]);
+  for (size_t i = 0; i < nw; ++i) memset(B[i], 0, d * sizeof B[i][0]);
+  for (int q = 0; q < nq; ++q) {
+    double x[NMAX] = {0.0}, jq[NMAX * NMAX], f0[NMAX], f1[NMAX], yt[HM_SYSTEM_MAX_WHEELSETS] = {0.0};
+    const double wq = moving ? GH_W[q] / sqrt(HM_PI) : 1.0;
+    if (moving)
+      for (size_t i = 0; i < nw; ++i) x[sys->wheelset_y_state[i]] = sqrt(2.0) * motion_rms_m[i] * GH_X[q];
+    hm_status st = sys->jacobian(sys->model, v, x, jq);
+    if (st == HM_OK) st = sys->rhs_track(sys->model, v, x, yt, f0);
+    if (st != HM_OK) return st;
+    for (size_t k = 0; k < d * d; ++k) jac[k] += wq * jq[k];
+    for (size_t i = 0; i < nw; ++i) { /* d f / d y_track_i by a one-sided difference */
+      yt[i] = h;
+      st = sys->rhs_track(sys->model, v, x, yt, f1);
+      yt[i] = 0.0;
+      if (st != HM_OK) return st;
+      for (size_t r = 0; r < d; ++r) B[i][r] += wq * (f1[r] - f0[r]) / h;
+    }
+  }
+  return HM_OK;
 }
 
 static hm_status sensor_spectrum(hm_mode_model m, double conicity, double speed_kmh, const hm_sensor_point *point,
-                                 const double *f_hz, size_t n, double shift, double *shape) {
+                                 const double *f_hz, size_t n, double shift, const double *motion_rms_m,
+                                 double *shape, double *motion_out) {
   if (!m || !point || !f_hz || !shape || n == 0 || !(speed_kmh > 0.0) || !isfinite(speed_kmh) ||
       !isfinite(conicity) || conicity < 0.0)
     return HM_EDOMAIN;
@@ -559,18 +648,9 @@ static hm_status sensor_spectrum(hm_mode_model m, double conicity, double speed_
   const hm_system *sys = &m->sys;
   if (!hm_sensor_point_valid(sys, point)) return HM_EINVAL;
   const size_t d = sys->dim, nw = sys->n_wheelsets;
-  const double v = hm_mps_from_kmh(speed_kmh), h = 1e-7;
-  double jac[NMAX * NMAX], x0[NMAX] = {0.0}, f0[NMAX], f1[NMAX], B[HM_SYSTEM_MAX_WHEELSETS][NMAX];
-  double yt[HM_SYSTEM_MAX_WHEELSETS] = {0.0};
-  if ((st = sys->jacobian(sys->model, v, x0, jac)) != HM_OK) return st;
-  if ((st = sys->rhs_track(sys->model, v, x0, yt, f0)) != HM_OK) return st;
-  for (size_t i = 0; i < nw; ++i) { /* d f / d y_track_i: linear in the track at the origin */
-    yt[i] = h;
-    st = sys->rhs_track(sys->model, v, x0, yt, f1);
-    yt[i] = 0.0;
-    if (st != HM_OK) return st;
-    for (size_t r = 0; r < d; ++r) B[i][r] = (f1[r] - f0[r]) / h;
-  }
+  const double v = hm_mps_from_kmh(speed_kmh);
+  double jac[NMAX * NMAX], B[HM_SYSTEM_MAX_WHEELSETS][NMAX];
+  if ((st = linearised(sys, v, motion_rms_m, jac, B)) != HM_OK) return st;
   for (size_t k = 0; k < n; ++k) {
     const double w = 2.0 * HM_PI * f_hz[k];
     if (!(w > 0.0) || !isfinite(w)) return HM_EDOMAIN;
@@ -595,93 +675,11 @@ static hm_status sensor_spectrum(hm_mode_model m, double conicity, double speed_
     const double S = hm_track_alignment_psd(w / v) / v;
     shape[k] = creal(acc * conj(acc)) * S;
     if (!isfinite(shape[k])) return HM_ENONFINITE;
-  }
-  return HM_OK;
-}
-
-/* -sum log-likelihood (Whittle, per bin, up to a constant) with the amplitude and floor profiled out. */
-static double whittle_profile(const double *g, const double *p, size_t n, double *amp, double *floor_) {
-  double pmin = INFINITY, pmax = 0.0, gmean = 0.0, pmean = 0.0;
-  for (size_t k = 0; k < n; ++k) pmin = fmin(pmin, p[k]), pmax = fmax(pmax, p[k]), gmean += g[k], pmean += p[k];
-  gmean /= (double)n, pmean /= (double)n;
-  double best = INFINITY;
-  for (int j = 0; j < 30; ++j) {
-    const double fl = 0.01 * pmin * pow(50.0 * pmax / (0.01 * pmin), j / 29.0);
-    double a = fmax((pmean - fl) / gmean, 1e-300);
-    for (int it = 0; it < 30; ++it) { /* Newton on the amplitude */
-      double gr = 0.0, he = 0.0;
-      for (size_t k = 0; k < n; ++k) {
-        const double mk = a * g[k] + fl;
-        gr += g[k] / mk - p[k] * g[k] / (mk * mk);
-        he += -g[k] * g[k] / (mk * mk) + 2.0 * p[k] * g[k] * g[k] / (mk * mk * mk);
-      }
-      a = he > 0.0 ? fmax(a - gr / he, 0.1 * a) : 0.5 * a;
+    for (size_t i = 0; motion_out && i < nw; ++i) { /* wheelset i's displacement from the track under it */
+      const double _Complex r = x[sys->wheelset_y_state[i]] - ua[i];
+      motion_out[i * n + k] = creal(r * conj(r)) * S;
     }
-    double l = 0.0;
-    for (size_t k = 0; k < n; ++k) {
-      const double mk = a * g[k] + fl;
-      l += p[k] / mk + log(mk);
-    }
-    if (l < best) best = l, *amp = a, *floor_ = fl;
   }
-  return best;
-}
-
-typedef struct {
-  hm_mode_model m;
-  double v_kmh;
-  const hm_sensor_point *point;
-  const double *f, *p;
-  size_t n;
-  double *g;
-  double amp, floor_;
-} fit_ctx;
-
-static double fit_objective(fit_ctx *c, double lambda) {
-  if (hm_mode_model_sensor_spectrum(c->m, lambda, c->v_kmh, c->point, c->f, c->n, c->g) != HM_OK) return INFINITY;
-  return whittle_profile(c->g, c->p, c->n, &c->amp, &c->floor_);
-}
-
-hm_status hm_mode_model_fit_spectrum(hm_mode_model m, double speed_kmh, const hm_sensor_point *point,
-                                     const double *f_hz, const double *psd, size_t n, double dof, double lo,
-                                     double hi, double tol, hm_spectrum_fit *out) {
-  if (!m || !point || !f_hz || !psd || !out || n < 8 || n > 4096 || !(dof >= 2.0) || !(lo > 0.0) || !(hi > lo) ||
-      !isfinite(hi) || !(tol > 0.0))
-    return HM_EDOMAIN;
-  for (size_t k = 0; k < n; ++k)
-    if (!(psd[k] > 0.0) || !isfinite(psd[k])) return HM_EDOMAIN;
-  double g[4096];
-  fit_ctx c = {m, speed_kmh, point, f_hz, psd, n, g, 0.0, 0.0};
-  enum { SCAN = 24 };
-  double best = INFINITY;
-  int kb = -1;
-  double lv[SCAN], ov[SCAN];
-  for (int k = 0; k < SCAN; ++k) {
-    lv[k] = lo * pow(hi / lo, (double)k / (SCAN - 1));
-    ov[k] = fit_objective(&c, lv[k]);
-    if (ov[k] < best) best = ov[k], kb = k;
-  }
-  if (kb < 0) return HM_ENOCONV;
-  /* golden section in log lambda over the best scan point's neighbours */
-  double a = log(lv[kb > 0 ? kb - 1 : 0]), b = log(lv[kb < SCAN - 1 ? kb + 1 : SCAN - 1]);
-  const double r = 0.5 * (sqrt(5.0) - 1.0);
-  double x1 = b - r * (b - a), x2 = a + r * (b - a), f1 = fit_objective(&c, exp(x1)), f2 = fit_objective(&c, exp(x2));
-  for (int it = 0; it < 200 && exp(b) - exp(a) > tol; ++it) {
-    if (f1 < f2) b = x2, x2 = x1, f2 = f1, x1 = b - r * (b - a), f1 = fit_objective(&c, exp(x1));
-    else a = x1, x1 = x2, f1 = f2, x2 = a + r * (b - a), f2 = fit_objective(&c, exp(x2));
-  }
-  const double lam = exp(0.5 * (a + b));
-  const double l0 = fit_objective(&c, lam);
-  const double amp = c.amp, fl = c.floor_;
-  /* the curvature of -2 log L = dof * sum(...) at the minimum: its standard error */
-  const double dl = 0.01 * lam, lp = fit_objective(&c, lam + dl), lm = fit_objective(&c, lam - dl);
-  const double curv = dof * (lp - 2.0 * l0 + lm) / (dl * dl);
-  if (!isfinite(l0)) return HM_ENOCONV;
-  out->conicity = lam;
-  out->conicity_se = curv > 0.0 ? sqrt(2.0 / curv) : INFINITY;
-  out->amplitude = amp;
-  out->noise = fl;
-  out->neg2_log_lik = dof * l0;
   return HM_OK;
 }
 
@@ -768,7 +766,7 @@ static hm_status reading_fit(hm_mode_model m, double conicity, double v_kmh, uns
   /* the leakage of a window of HM_MODE_MODEL_READING_WINDOW_S on both sides: the spectrum's poles moved left by
    * HM_WHITTLE_LEAKAGE / T and the fit told T (a peak far narrower than the bins is then a few bins wide) */
   const double T = HM_MODE_MODEL_READING_WINDOW_S;
-  hm_status st = sensor_spectrum(m, conicity, v_kmh, &m->sensor, m->rd_f, n, HM_WHITTLE_LEAKAGE / T, m->rd_p);
+  hm_status st = sensor_spectrum(m, conicity, v_kmh, &m->sensor, m->rd_f, n, HM_WHITTLE_LEAKAGE / T, NULL, m->rd_p, NULL);
   if (st != HM_OK) return st;
   double mean = 0.0;
   for (size_t k = 0; k < n; ++k) {

@@ -2,6 +2,7 @@
 #include "hunting_monitor/monitor.h"
 
 #include "hunting_monitor/linear.h"
+#include "hunting_monitor/spectrum_fit.h"
 
 #include <math.h>
 #include <stdio.h>
@@ -42,6 +43,8 @@ struct hm_monitor_s {
   double refine_failed_at;       /* the conicity whose exact family could not be computed; NAN if none */
   double a_prev;                 /* the previous accepted acceleration sample (bridging lost samples) */
   double large_at;               /* the latest update that saw a large oscillation (-inf: none) */
+  hm_sensor_point sensor;        /* a model's sensor, whose spectrum a window's is fitted by (margin.spectrum_*_hz) */
+  double *spec_f, *spec_p;       /* that fit's bins (HM_SPECTRUM_FIT_MAX_BINS each; NULL: no such fit) */
 };
 
 void hm_monitor_config_default(hm_monitor_config *c) {
@@ -176,6 +179,14 @@ hm_status hm_monitor_create_model(const hm_monitor_config *cfg, hm_model_kind ki
     if (st == HM_OK)
       st = hm_mode_model_set_sensor(model, cfg->estimator.measurement_point == HM_POINT_BOGIE_FRAME ? "frame" : "axlebox");
     hm_mode_model_set_reading_gain(model, hm_modal_filter_power_gain, m->modal);
+    if (st == HM_OK && cfg->margin.spectrum_high_hz > 0.0) { /* the spectrum's fit (margin.h) */
+      m->spec_f = malloc(HM_SPECTRUM_FIT_MAX_BINS * sizeof(double));
+      m->spec_p = malloc(HM_SPECTRUM_FIT_MAX_BINS * sizeof(double));
+      st = m->spec_f && m->spec_p ? HM_OK : HM_ENOMEM;
+      if (st == HM_OK)
+        st = hm_mode_model_sensor(model, cfg->estimator.measurement_point == HM_POINT_BOGIE_FRAME ? "frame" : "axlebox",
+                                  &m->sensor);
+    }
     hm_margin_set_model(m->margin, model);
     if (st == HM_OK) st = hm_alarm_set_model(m->alarm, model);
   }
@@ -209,6 +220,8 @@ void hm_monitor_destroy(hm_monitor m) {
   hm_table_destroy(m->table);
   hm_mode_model_destroy(m->model);
   free(m->chunks);
+  free(m->spec_f);
+  free(m->spec_p);
   free(m);
 }
 
@@ -291,6 +304,30 @@ static void track_lines_of(hm_monitor m, double t, double v, hm_mode_estimate *m
     hm_track_lines_observe(&m->lines, t, v, mode->line_fundamental_hz, 0.0, 1);
 }
 
+/* The window's conicity from the model's whole spectrum at the sensor (spectrum_fit.h, linearised about the motion it
+ * implies), for the margin (margin.h): where it has a model and the band set, the window's mode was read and no narrow
+ * peak (a line or the mode, the margin's question) is in it. */
+static void spectrum_of(hm_monitor m, hm_mode_estimate *e) {
+  e->spectrum_valid = 0;
+  if (!m->spec_f || !e->valid || e->narrow_peak) return;
+  size_t n;
+  double dof, window_s;
+  if (hm_modal_window_spectrum(m->modal, m->cfg.margin.spectrum_low_hz, m->cfg.margin.spectrum_high_hz, m->spec_f,
+                               m->spec_p, HM_SPECTRUM_FIT_MAX_BINS, &n, &dof, &window_s) != HM_OK)
+    return;
+  hm_spectrum_fit_options o;
+  hm_spectrum_fit_options_default(&o);
+  o.window_s = window_s;
+  hm_spectrum_fit fit;
+  if (hm_spectrum_fit_conicity(m->model, m->mode_speed, &m->sensor, m->spec_f, m->spec_p, n, dof, &o, &fit) != HM_OK)
+    return;
+  e->spectrum_valid = 1;
+  e->spectrum_conicity = fit.conicity;
+  e->spectrum_conicity_se = fit.conicity_se;
+  e->spectrum_conicity_at_rest = fit.conicity_at_rest;
+  e->spectrum_motion_rms_m = fit.motion_rms_m;
+}
+
 /* A fit of the identification. At a steady speed (the newest stretch whose speed varied by at most the margin's
  * max_speed_spread_kmh) the part of the stretch not yet given to the margin is fitted, up to window_s: a full
  * window is committed to the margin, a shorter one (from min_window_s) is its provisional window, committed when the
@@ -352,6 +389,8 @@ static void fit(hm_monitor m, double t) {
     m->committed_until = t;
     return;
   }
+  spectrum_of(m, &e);
+  m->mode = e;
   /* a full window, or on a ramp the whole stretch the spread allows (back to back, each once) */
   if (e.window_s >= mc->window_s * (1.0 - 1e-9) || (ramp && fresh >= steady.duration_s - 1e-9)) {
     hm_margin_add_window(m->margin, t, m->mode_speed, m->mode_spread, &e, &m->verdict);

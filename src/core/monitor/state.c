@@ -109,6 +109,11 @@ uint64_t hm_state_hash(const hm_monitor_config *cfg, const hm_vehicle *veh) {
                        g->min_speed_kmh, g->memory_s, g->min_speed_span_kmh, g->max_extrapolation_kmh,
                        g->interval_z, g->max_misfit_chi2, g->change_z};
   for (size_t k = 0; k < sizeof gv / sizeof gv[0]; ++k) h = fnv_f64(h, gv[k]);
+  if (g->spectrum_high_hz != 0.0) { /* (off: the hash of before) */
+    h = fnv_f64(h, g->spectrum_low_hz);
+    h = fnv_f64(h, g->spectrum_high_hz);
+    h = fnv_f64(h, g->spectrum_model_error);
+  }
   return h;
 }
 

@@ -1,0 +1,64 @@
+/*
+ * hunting_monitor - a conicity from the whole spectrum a vehicle model predicts at its sensor (issue #28).
+ * A measured spectrum over a band is fitted by the model's spectrum at the sensor (mode_model.h: the linearised model
+ * driven by the track under each wheelset) times a factor (the track's irregularity against the model's assumed
+ * spectrum) plus a white floor (the sensor's noise), by the Whittle likelihood, over the conicity: a geometric scan of
+ * the range, then golden section in ln(conicity) to tol. The factor and the floor are profiled out (Fisher scoring in
+ * their logarithms) at each conicity. The standard error is the likelihood's curvature's (second differences 1% of
+ * the conicity apart).
+ * The model's spectrum is linearised at rest first; with passes > 0 the fit is repeated linearised about the motion of
+ * the wheelsets the previous fit implies (hm_mode_model_motion_rms from its factor: Gaussian equivalent linearisation,
+ * hm_running). At rest MODEL.md's flange force has no slope; at 1 mm of random motion its mean slope softens the
+ * wheelsets' lateral support by about 0.5 MN/m, and a fit at rest reads the default bogie's conicity 5-10% low (its
+ * Hopf speed 15-30 km/h high) 30 km/h below the Hopf speed (docs/VEHICLES.md).
+ * The measured spectrum is a two-sided density [(m/s^2)^2 / Hz] of the sensor's acceleration (any filter's power gain
+ * divided out, so that the factor and the motion are absolute), each bin with dof degrees of freedom (2 for one
+ * periodogram, 2 / padding for a zero-padded one, 2 K for a mean of K). Nothing is allocated (at most
+ * HM_SPECTRUM_FIT_MAX_BINS bins; the work arrays are on the stack).
+ */
+#ifndef HUNTING_MONITOR_SPECTRUM_FIT_H
+#define HUNTING_MONITOR_SPECTRUM_FIT_H
+
+#include <stddef.h>
+
+#include "hunting_monitor/mode_model.h"
+#include "hunting_monitor/status.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+#define HM_SPECTRUM_FIT_MAX_BINS 4096
+#define HM_SPECTRUM_FIT_MAX_PASSES 8
+
+typedef struct {
+  double conicity_min, conicity_max; /* the search's range, 0 < min < max */
+  double tol;                        /* the golden section's final bracket [conicity], > 0 */
+  double window_s;                   /* the periodogram's window [s] for the poles' leakage (0: none, a long mean) */
+  unsigned passes;                   /* linearisations about the motion found, 0..HM_SPECTRUM_FIT_MAX_PASSES */
+} hm_spectrum_fit_options;
+
+/* 0.02-0.8, tol 1e-5, no leakage, 2 passes. */
+void hm_spectrum_fit_options_default(hm_spectrum_fit_options *o);
+
+typedef struct {
+  double conicity, conicity_se;  /* the likelihood's minimum (the last pass's) and its curvature's error */
+  double conicity_at_rest;       /* the first pass's, linearised at rest (the running's effect: the difference) */
+  double amplitude, noise;       /* the shape's factor and the white floor [(m/s^2)^2 / Hz] */
+  double motion_rms_m;           /* the leading wheelset's rms displacement from the track the fit implies [m] */
+  double neg2_log_lik;           /* -2 log L at the minimum (up to a constant) */
+  size_t bins;                   /* the bins fitted */
+} hm_spectrum_fit;
+
+/* The conicity whose spectrum at the point explains psd[] at f_hz[] (n bins, each > 0 and finite) best at the speed
+ * [km/h]. HM_EDOMAIN for bad input (n below 8 or above HM_SPECTRUM_FIT_MAX_BINS, dof below 2 / 64, options out of
+ * range), HM_ENOCONV where the minimum lies at the range's edge or no conicity gives a spectrum; out untouched then. */
+hm_status hm_spectrum_fit_conicity(hm_mode_model m, double speed_kmh, const hm_sensor_point *point, const double *f_hz,
+                                   const double *psd, size_t n, double dof, const hm_spectrum_fit_options *o,
+                                   hm_spectrum_fit *out);
+
+#ifdef __cplusplus
+}
+#endif
+
+#endif

@@ -1,0 +1,134 @@
+/* A conicity from the whole spectrum a vehicle model predicts at its sensor (see spectrum_fit.h). */
+#include "hunting_monitor/spectrum_fit.h"
+
+#include <math.h>
+#include <string.h>
+
+enum { SCAN = 24, REFINE_SCAN = 9, GOLDEN_MAX = 200, PROFILE_MAX = 200 };
+
+void hm_spectrum_fit_options_default(hm_spectrum_fit_options *o) {
+  if (!o) return;
+  o->conicity_min = 0.02;
+  o->conicity_max = 0.8;
+  o->tol = 1e-5;
+  o->window_s = 0.0;
+  o->passes = 2;
+}
+
+/* sum_k p_k / m_k + ln m_k with m_k = a g_k + c, a and c > 0 chosen to minimise it (-log L per degree of freedom
+ * pair, Whittle): Fisher scoring in (ln a, ln c), steps clipped to a factor e^2, c kept above 1e-6 of the least p. */
+static double profile(const double *g, const double *p, size_t n, double *amp, double *floor_) {
+  double gmean = 0.0, pmean = 0.0, pmin = INFINITY;
+  for (size_t k = 0; k < n; ++k) gmean += g[k], pmean += p[k], pmin = fmin(pmin, p[k]);
+  if (!(gmean > 0.0) || !isfinite(gmean)) return INFINITY;
+  double la = log(0.9 * pmean / gmean), lc = log(0.1 * pmean);
+  const double lc_min = log(1e-6 * pmin);
+  for (int it = 0; it < PROFILE_MAX; ++it) {
+    const double a = exp(la), c = exp(lc);
+    double s1 = 0.0, s2 = 0.0, i11 = 0.0, i12 = 0.0, i22 = 0.0;
+    for (size_t k = 0; k < n; ++k) {
+      const double mk = a * g[k] + c, d1 = a * g[k] / mk, d2 = c / mk, r = p[k] / mk - 1.0;
+      s1 += d1 * r, s2 += d2 * r;
+      i11 += d1 * d1, i12 += d1 * d2, i22 += d2 * d2;
+    }
+    const double det = i11 * i22 - i12 * i12;
+    double x1 = s1 / i11, x2 = 0.0;
+    if (det > 1e-12 * i11 * i22) x1 = (i22 * s1 - i12 * s2) / det, x2 = (i11 * s2 - i12 * s1) / det;
+    x1 = fmax(fmin(x1, 2.0), -2.0), x2 = fmax(fmin(x2, 2.0), -2.0);
+    la += x1, lc = fmax(lc + x2, lc_min);
+    if (fabs(x1) + fabs(x2) < 1e-10) break;
+  }
+  *amp = exp(la), *floor_ = exp(lc);
+  double l = 0.0;
+  for (size_t k = 0; k < n; ++k) {
+    const double mk = *amp * g[k] + *floor_;
+    l += p[k] / mk + log(mk);
+  }
+  return isfinite(l) ? l : INFINITY;
+}
+
+typedef struct {
+  hm_mode_model m;
+  double v_kmh;
+  const hm_sensor_point *point;
+  const hm_running *run;
+  const double *f, *p;
+  size_t n;
+  double *g;
+  double amp, floor_; /* of the last evaluation */
+} fit_ctx;
+
+static double objective(fit_ctx *c, double lambda) {
+  if (hm_mode_model_running_spectrum(c->m, lambda, c->v_kmh, c->point, c->run, c->f, c->n, c->g) != HM_OK)
+    return INFINITY;
+  return profile(c->g, c->p, c->n, &c->amp, &c->floor_);
+}
+
+/* The minimum over [lo, hi]: a geometric scan of `scan` points, then golden section in ln(conicity) over the best
+ * point's neighbours to tol. 0 where it lies at an end of the range (not bracketed) or nothing was finite. */
+static int minimise(fit_ctx *c, double lo, double hi, int scan, double tol, double *lambda) {
+  double best = INFINITY;
+  int kb = -1;
+  double lv[SCAN];
+  for (int k = 0; k < scan; ++k) {
+    lv[k] = lo * pow(hi / lo, (double)k / (scan - 1));
+    const double o = objective(c, lv[k]);
+    if (o < best) best = o, kb = k;
+  }
+  if (kb <= 0 || kb >= scan - 1) return 0;
+  double a = log(lv[kb - 1]), b = log(lv[kb + 1]);
+  const double r = 0.5 * (sqrt(5.0) - 1.0);
+  double x1 = b - r * (b - a), x2 = a + r * (b - a), f1 = objective(c, exp(x1)), f2 = objective(c, exp(x2));
+  for (int it = 0; it < GOLDEN_MAX && exp(b) - exp(a) > tol; ++it) {
+    if (f1 < f2) b = x2, x2 = x1, f2 = f1, x1 = b - r * (b - a), f1 = objective(c, exp(x1));
+    else a = x1, x1 = x2, f1 = f2, x2 = a + r * (b - a), f2 = objective(c, exp(x2));
+  }
+  *lambda = exp(0.5 * (a + b));
+  return 1;
+}
+
+static int options_ok(const hm_spectrum_fit_options *o) {
+  return o && o->conicity_min > 0.0 && o->conicity_max > o->conicity_min && isfinite(o->conicity_max) &&
+         o->tol > 0.0 && isfinite(o->tol) && o->window_s >= 0.0 && isfinite(o->window_s) &&
+         o->passes <= HM_SPECTRUM_FIT_MAX_PASSES;
+}
+
+hm_status hm_spectrum_fit_conicity(hm_mode_model m, double speed_kmh, const hm_sensor_point *point, const double *f_hz,
+                                   const double *psd, size_t n, double dof, const hm_spectrum_fit_options *o,
+                                   hm_spectrum_fit *out) {
+  if (!m || !point || !f_hz || !psd || !out || !options_ok(o) || n < 8 || n > HM_SPECTRUM_FIT_MAX_BINS ||
+      !(dof >= 2.0 / 64.0) || !isfinite(dof) || !(speed_kmh > 0.0) || !isfinite(speed_kmh))
+    return HM_EDOMAIN;
+  for (size_t k = 0; k < n; ++k)
+    if (!(psd[k] > 0.0) || !isfinite(psd[k]) || !(f_hz[k] > 0.0) || !isfinite(f_hz[k])) return HM_EDOMAIN;
+  double g[HM_SPECTRUM_FIT_MAX_BINS];
+  hm_running run;
+  memset(&run, 0, sizeof run);
+  run.window_s = o->window_s;
+  fit_ctx c = {m, speed_kmh, point, &run, f_hz, psd, n, g, 0.0, 0.0};
+  double lam, at_rest = NAN, motion[HM_SYSTEM_MAX_WHEELSETS] = {0.0};
+  for (unsigned pass = 0; pass <= o->passes; ++pass) {
+    /* the first over the range; each later one about the conicity before it (the motion changes it by 5-10%) */
+    const int ok = pass == 0 ? minimise(&c, o->conicity_min, o->conicity_max, SCAN, o->tol, &lam)
+                             : minimise(&c, fmax(lam / 1.5, o->conicity_min), fmin(lam * 1.5, o->conicity_max),
+                                        REFINE_SCAN, o->tol, &lam);
+    if (!ok) return HM_ENOCONV;
+    if (pass == 0) at_rest = lam;
+    if (!isfinite(objective(&c, lam))) return HM_ENOCONV;
+    if (hm_mode_model_motion_rms(m, lam, speed_kmh, &run, c.amp, motion) != HM_OK) return HM_ENOCONV;
+    if (pass < o->passes) memcpy(run.motion_rms_m, motion, sizeof motion);
+  }
+  const double l0 = objective(&c, lam), amp = c.amp, fl = c.floor_;
+  const double dl = 0.01 * lam, lp = objective(&c, lam + dl), lm = objective(&c, lam - dl);
+  const double curv = dof * (lp - 2.0 * l0 + lm) / (dl * dl);
+  if (!isfinite(l0) || !isfinite(curv)) return HM_ENOCONV;
+  out->conicity = lam;
+  out->conicity_se = curv > 0.0 ? sqrt(2.0 / curv) : INFINITY;
+  out->conicity_at_rest = at_rest;
+  out->amplitude = amp;
+  out->noise = fl;
+  out->motion_rms_m = motion[0];
+  out->neg2_log_lik = dof * l0;
+  out->bins = n;
+  return HM_OK;
+}
