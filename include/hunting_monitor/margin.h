@@ -105,13 +105,17 @@ typedef struct {
   double max_misfit_chi2;        /* a window the model explains worse than this (chi2, 1 dof) is a misfit */
   double change_z;               /* a window this many combined standard errors from the mean is a change */
   /* with a vehicle model (hm_margin_set_model): a window's conicity from the model's whole spectrum at the sensor over
-   * this band [Hz] (spectrum_fit.h; both 0: off, the mode's reading inverted), with a relative systematic error */
+   * this band [Hz] (spectrum_fit.h; both 0: off, the mode's reading inverted), with a relative systematic error; a
+   * window whose spectrum's shape the model misses by more than spectrum_max_shape_chi2 (about chi2 with 5 degrees
+   * of freedom where it explains it) is a misfit */
   double spectrum_low_hz, spectrum_high_hz;
   double spectrum_model_error;
+  double spectrum_max_shape_chi2;
 } hm_margin_config;
 
 /* Defaults: 1%, 5%, 12 km/h, 200 km/h, 900 s, 20 km/h, 150 km/h, z = 2 (about 95%), misfit chi2 9 (3 standard
- * errors), change at 4 standard errors, the spectrum's conicity off (its error 2% when set). */
+ * errors), change at 4 standard errors, the spectrum's conicity off (its error 2%, its shape's chi2 at most 30, when
+ * set). */
 void hm_margin_config_default(hm_margin_config *cfg);
 hm_status hm_margin_config_validate(const hm_margin_config *cfg, char *why, size_t why_len);
 

@@ -204,9 +204,11 @@ typedef struct {
   double speed_tracking, speed_tracking_se;
   /* set by the caller with a vehicle model (monitor.h; spectrum_fit.h), 0 from the fit: the conicity whose spectrum at
    * the sensor explains the window's (margin.h's spectrum band), its standard error, the one the model at rest would
-   * have read, and the leading wheelset's rms displacement from the track the fit implies [m] */
+   * have read, the leading wheelset's rms displacement from the track the fit implies [m], and the fit's shape against
+   * the spectrum's (spectrum_fit.h's shape_chi2) */
   int spectrum_valid;
   double spectrum_conicity, spectrum_conicity_se, spectrum_conicity_at_rest, spectrum_motion_rms_m;
+  double spectrum_shape_chi2;
 } hm_mode_estimate;
 
 /* The window's halves' speeds must differ by at least this in ln(V2 / V1) for speed_tracking: a line then moves 1% of

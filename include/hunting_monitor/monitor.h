@@ -42,6 +42,11 @@
 #include "hunting_monitor/tables.h"
 #include "hunting_monitor/track_lines.h"
 
+/* A bogie's or car's monitor with margin.spectrum_*_hz set fits each window's spectrum by its model (spectrum_fit.h):
+ * every full window, and a steady stretch's provisional window at most this often [s] (between, the stretch's last
+ * fit stands for it). */
+#define HM_MONITOR_SPECTRUM_EVERY_S 5.0
+
 #ifdef __cplusplus
 extern "C" {
 #endif

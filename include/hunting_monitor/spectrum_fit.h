@@ -30,6 +30,7 @@ extern "C" {
 
 #define HM_SPECTRUM_FIT_MAX_BINS 4096
 #define HM_SPECTRUM_FIT_MAX_PASSES 8
+#define HM_SPECTRUM_FIT_SHAPE_PARTS 8
 
 typedef struct {
   double conicity_min, conicity_max; /* the search's range, 0 < min < max */
@@ -38,7 +39,7 @@ typedef struct {
   unsigned passes;                   /* linearisations about the motion found, 0..HM_SPECTRUM_FIT_MAX_PASSES */
 } hm_spectrum_fit_options;
 
-/* 0.02-0.8, tol 1e-5, no leakage, 2 passes. */
+/* 0.02-0.8, tol 1e-4 (a tenth of the least standard error seen), no leakage, 2 passes. */
 void hm_spectrum_fit_options_default(hm_spectrum_fit_options *o);
 
 typedef struct {
@@ -48,6 +49,12 @@ typedef struct {
   double motion_rms_m;           /* the leading wheelset's rms displacement from the track the fit implies [m] */
   double neg2_log_lik;           /* -2 log L at the minimum (up to a constant) */
   size_t bins;                   /* the bins fitted */
+  double deviance_per_bin;       /* 2 (x - ln x - 1) over the bins, x = psd / the fit, its mean: 2 gamma = 1.154 for a
+                                    periodogram's bins the model explains (exponential about it), more where not */
+  double shape_chi2;             /* the fit's shape: the bins in HM_SPECTRUM_FIT_SHAPE_PARTS equal parts, each part's
+                                    mean of x against 1 in its standard error sqrt(2 / (dof m)), squared and summed:
+                                    about chi2 with 5 degrees of freedom (8 parts less the 3 fitted) where the model's
+                                    shape is the spectrum's, far more where it is not */
 } hm_spectrum_fit;
 
 /* The conicity whose spectrum at the point explains psd[] at f_hz[] (n bins, each > 0 and finite) best at the speed

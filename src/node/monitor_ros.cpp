@@ -481,6 +481,9 @@ void MonitorRos::fillMode(const hm_report& r, hunting_monitor::HuntingStatus& m)
   m.speed_tracking_measured = std::isfinite(r.mode_speed_tracking);
   m.mode_speed_tracking = finite(r.mode_speed_tracking);
   m.mode_speed_tracking_se = finite(r.mode_speed_tracking_se);
+  m.spectrum_conicity = finite(r.spectrum_conicity);
+  m.spectrum_conicity_se = finite(r.spectrum_conicity_se);
+  m.spectrum_motion_rms_m = finite(r.spectrum_motion_rms_m);
 }
 
 void MonitorRos::fillMargin(const hm_report& r, hunting_monitor::HuntingStatus& m) {

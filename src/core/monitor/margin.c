@@ -74,6 +74,7 @@ void hm_margin_config_default(hm_margin_config *c) {
   c->change_z = 4.0;
   c->spectrum_low_hz = c->spectrum_high_hz = 0.0;
   c->spectrum_model_error = 0.02;
+  c->spectrum_max_shape_chi2 = 30.0;
 }
 
 hm_status hm_margin_config_validate(const hm_margin_config *c, char *why, size_t len) {
@@ -91,7 +92,8 @@ hm_status hm_margin_config_validate(const hm_margin_config *c, char *why, size_t
       {"change_z", c->change_z, HM_RULE_RANGE, 1.0, 100.0},
       {"spectrum_low_hz", c->spectrum_low_hz, HM_RULE_OFF_OR_RANGE, 0.5, 200.0},
       {"spectrum_high_hz", c->spectrum_high_hz, HM_RULE_OFF_OR_RANGE, 1.0, 500.0},
-      {"spectrum_model_error", c->spectrum_model_error, HM_RULE_RANGE, 0.0, 0.5}};
+      {"spectrum_model_error", c->spectrum_model_error, HM_RULE_RANGE, 0.0, 0.5},
+      {"spectrum_max_shape_chi2", c->spectrum_max_shape_chi2, HM_RULE_RANGE, 1.0, 1e6}};
   const hm_status st = hm_check_fields(f, HM_COUNT_OF(f), why, len);
   if (st != HM_OK) return st;
   if ((c->spectrum_low_hz == 0.0) != (c->spectrum_high_hz == 0.0) ||
@@ -261,15 +263,20 @@ static hm_window_verdict prepare_reading(const hm_margin m, double t_end, double
  * peak in the window): the reading's pole pairs hold a small part of what the spectrum tells (a frame's 8 Hz mode
  * gave conicity errors of 0.007-0.014 a window, the spectrum 0.0006-0.003). Its systematic error is
  * spectrum_model_error of the conicity (the model's own spectrum fitted back over a bogie frame's 4-22 Hz scattered by
- * 1.2% 30 km/h below the Hopf speed, where the curvature gave 0.5%: docs/VEHICLES.md). */
-static void use_spectrum(const hm_margin m, const hm_mode_estimate *mode, window *w) {
-  if (!reads_by_model(m) || !(m->cfg.spectrum_high_hz > 0.0) || !mode->spectrum_valid ||
-      !(mode->spectrum_conicity > 0.0) || !(mode->spectrum_conicity_se > 0.0) || !isfinite(mode->spectrum_conicity_se))
-    return;
+ * 1.2% 30 km/h below the Hopf speed, where the curvature gave 0.5%: docs/VEHICLES.md). Where the model misses the
+ * spectrum's shape (shape_chi2 above spectrum_max_shape_chi2: a vehicle that is not the model, whose frame's spectrum
+ * a wrong conicity would be made to explain) the window is a misfit: HM_WINDOW_MISFIT, else v unchanged. */
+static hm_window_verdict use_spectrum(const hm_margin m, const hm_mode_estimate *mode, window *w, hm_window_verdict v) {
+  if (v != HM_WINDOW_USED || mode->narrow_peak || !reads_by_model(m) || !(m->cfg.spectrum_high_hz > 0.0) ||
+      !mode->spectrum_valid || !(mode->spectrum_conicity > 0.0) || !(mode->spectrum_conicity_se > 0.0) ||
+      !isfinite(mode->spectrum_conicity_se))
+    return v;
+  if (!(mode->spectrum_shape_chi2 <= m->cfg.spectrum_max_shape_chi2)) return HM_WINDOW_MISFIT;
   w->lambda = mode->spectrum_conicity;
   w->lambda_stat = mode->spectrum_conicity_se;
   w->lambda_sys = m->cfg.spectrum_model_error * mode->spectrum_conicity;
   w->lambda_se = hypot(w->lambda_stat, w->lambda_sys);
+  return v;
 }
 
 /* The estimate of the windows held at t (their inverse-variance mean; conicity_valid 0 without any). */
@@ -354,9 +361,9 @@ static hm_window_verdict prepare(const hm_margin m, double t_end, double speed_k
                                  const hm_mode_estimate *mode, window *w, hm_narrow_verdict *narrow) {
   hm_mode_reading primary;
   hm_mode_estimate_reading(mode, &primary);
-  const hm_window_verdict v = prepare_reading(m, t_end, speed_kmh, spread_kmh, mode->window_s, &primary, w);
+  const hm_window_verdict v =
+      use_spectrum(m, mode, w, prepare_reading(m, t_end, speed_kmh, spread_kmh, mode->window_s, &primary, w));
   *narrow = HM_NARROW_NONE;
-  if (v == HM_WINDOW_USED && !mode->narrow_peak) use_spectrum(m, mode, w);
   if (v == HM_WINDOW_USED || v == HM_WINDOW_MISFIT || v == HM_WINDOW_NO_INVERSION) {
     double lo, hi, se; /* the model's slope at the window's conicity, or (none found) at what is known */
     int from_windows;

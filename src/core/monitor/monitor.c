@@ -45,6 +45,8 @@ struct hm_monitor_s {
   double large_at;               /* the latest update that saw a large oscillation (-inf: none) */
   hm_sensor_point sensor;        /* a model's sensor, whose spectrum a window's is fitted by (margin.spectrum_*_hz) */
   double *spec_f, *spec_p;       /* that fit's bins (HM_SPECTRUM_FIT_MAX_BINS each; NULL: no such fit) */
+  hm_mode_estimate spec_last;    /* the last such fit's fields (spectrum_*), its time and where its data began */
+  double spec_at, spec_stretch;
 };
 
 void hm_monitor_config_default(hm_monitor_config *c) {
@@ -306,19 +308,31 @@ static void track_lines_of(hm_monitor m, double t, double v, hm_mode_estimate *m
 
 /* The window's conicity from the model's whole spectrum at the sensor (spectrum_fit.h, linearised about the motion it
  * implies), for the margin (margin.h): where it has a model and the band set, the window's mode was read and no narrow
- * peak (a line or the mode, the margin's question) is in it. */
-static void spectrum_of(hm_monitor m, hm_mode_estimate *e) {
+ * peak (a line or the mode, the margin's question) is in it. A full window is fitted; a stretch's provisional one
+ * takes the stretch's last fit while that is less than HM_MONITOR_SPECTRUM_EVERY_S old (a fit takes 0.1-0.4 s of a
+ * bogie's spectrum: every second it would hold the monitor behind real time). */
+static void spectrum_of(hm_monitor m, double t, double stretch_start, int full, hm_mode_estimate *e) {
   e->spectrum_valid = 0;
   if (!m->spec_f || !e->valid || e->narrow_peak) return;
+  if (!full && m->spec_last.spectrum_valid && fabs(m->spec_stretch - stretch_start) < 0.5 && t - m->spec_at >= 0.0 &&
+      t - m->spec_at < HM_MONITOR_SPECTRUM_EVERY_S) {
+    e->spectrum_valid = 1;
+    e->spectrum_conicity = m->spec_last.spectrum_conicity;
+    e->spectrum_conicity_se = m->spec_last.spectrum_conicity_se;
+    e->spectrum_conicity_at_rest = m->spec_last.spectrum_conicity_at_rest;
+    e->spectrum_motion_rms_m = m->spec_last.spectrum_motion_rms_m;
+    e->spectrum_shape_chi2 = m->spec_last.spectrum_shape_chi2;
+    return;
+  }
   size_t n;
   double dof, window_s;
+  hm_spectrum_fit_options o;
+  hm_spectrum_fit_options_default(&o);
+  hm_spectrum_fit fit;
   if (hm_modal_window_spectrum(m->modal, m->cfg.margin.spectrum_low_hz, m->cfg.margin.spectrum_high_hz, m->spec_f,
                                m->spec_p, HM_SPECTRUM_FIT_MAX_BINS, &n, &dof, &window_s) != HM_OK)
     return;
-  hm_spectrum_fit_options o;
-  hm_spectrum_fit_options_default(&o);
   o.window_s = window_s;
-  hm_spectrum_fit fit;
   if (hm_spectrum_fit_conicity(m->model, m->mode_speed, &m->sensor, m->spec_f, m->spec_p, n, dof, &o, &fit) != HM_OK)
     return;
   e->spectrum_valid = 1;
@@ -326,6 +340,10 @@ static void spectrum_of(hm_monitor m, hm_mode_estimate *e) {
   e->spectrum_conicity_se = fit.conicity_se;
   e->spectrum_conicity_at_rest = fit.conicity_at_rest;
   e->spectrum_motion_rms_m = fit.motion_rms_m;
+  e->spectrum_shape_chi2 = fit.shape_chi2;
+  m->spec_last = *e;
+  m->spec_at = t;
+  m->spec_stretch = stretch_start;
 }
 
 /* A fit of the identification. At a steady speed (the newest stretch whose speed varied by at most the margin's
@@ -389,10 +407,11 @@ static void fit(hm_monitor m, double t) {
     m->committed_until = t;
     return;
   }
-  spectrum_of(m, &e);
+  const int full = e.window_s >= mc->window_s * (1.0 - 1e-9) || (ramp && fresh >= steady.duration_s - 1e-9);
+  spectrum_of(m, t, t - fresh, full, &e);
   m->mode = e;
   /* a full window, or on a ramp the whole stretch the spread allows (back to back, each once) */
-  if (e.window_s >= mc->window_s * (1.0 - 1e-9) || (ramp && fresh >= steady.duration_s - 1e-9)) {
+  if (full) {
     hm_margin_add_window(m->margin, t, m->mode_speed, m->mode_spread, &e, &m->verdict);
     if (m->verdict == HM_WINDOW_USED) m->committed_until = t;
   } else {

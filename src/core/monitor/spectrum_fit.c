@@ -4,13 +4,13 @@
 #include <math.h>
 #include <string.h>
 
-enum { SCAN = 24, REFINE_SCAN = 9, GOLDEN_MAX = 200, PROFILE_MAX = 200 };
+enum { SCAN = 24, REFINE_SCAN = 9, GOLDEN_MAX = 200, PROFILE_MAX = 200, SHAPE_PARTS = HM_SPECTRUM_FIT_SHAPE_PARTS };
 
 void hm_spectrum_fit_options_default(hm_spectrum_fit_options *o) {
   if (!o) return;
   o->conicity_min = 0.02;
   o->conicity_max = 0.8;
-  o->tol = 1e-5;
+  o->tol = 1e-4;
   o->window_s = 0.0;
   o->passes = 2;
 }
@@ -97,7 +97,7 @@ hm_status hm_spectrum_fit_conicity(hm_mode_model m, double speed_kmh, const hm_s
                                    const double *psd, size_t n, double dof, const hm_spectrum_fit_options *o,
                                    hm_spectrum_fit *out) {
   if (!m || !point || !f_hz || !psd || !out || !options_ok(o) || n < 8 || n > HM_SPECTRUM_FIT_MAX_BINS ||
-      !(dof >= 2.0 / 64.0) || !isfinite(dof) || !(speed_kmh > 0.0) || !isfinite(speed_kmh))
+      !(dof >= 2.0 / 64.0) || !isfinite(dof) || n < 4 * HM_SPECTRUM_FIT_SHAPE_PARTS || !(speed_kmh > 0.0) || !isfinite(speed_kmh))
     return HM_EDOMAIN;
   for (size_t k = 0; k < n; ++k)
     if (!(psd[k] > 0.0) || !isfinite(psd[k]) || !(f_hz[k] > 0.0) || !isfinite(f_hz[k])) return HM_EDOMAIN;
@@ -119,6 +119,21 @@ hm_status hm_spectrum_fit_conicity(hm_mode_model m, double speed_kmh, const hm_s
     if (pass < o->passes) memcpy(run.motion_rms_m, motion, sizeof motion);
   }
   const double l0 = objective(&c, lam), amp = c.amp, fl = c.floor_;
+  double dev = 0.0; /* Whittle's deviance: 2 sum (x - ln x - 1), x = p / m, at the minimum */
+  for (size_t k = 0; k < n; ++k) {
+    const double x = psd[k] / (amp * g[k] + fl);
+    dev += 2.0 * (x - log(x) - 1.0);
+  }
+  /* the fit's shape against the spectrum's: the mean of x over each of SHAPE_PARTS equal parts of the bins is 1 within
+   * sqrt(2 / (dof m)) where the model explains them (x of m bins of dof / 2 periodograms each); their chi2 */
+  double shape = 0.0;
+  for (int j = 0; j < SHAPE_PARTS; ++j) {
+    const size_t k0 = n * (size_t)j / SHAPE_PARTS, k1 = n * (size_t)(j + 1) / SHAPE_PARTS;
+    double sx = 0.0;
+    for (size_t k = k0; k < k1; ++k) sx += psd[k] / (amp * g[k] + fl);
+    const double mj = (double)(k1 - k0), z = (sx / mj - 1.0) / sqrt(2.0 / (dof * mj));
+    shape += z * z;
+  }
   const double dl = 0.01 * lam, lp = objective(&c, lam + dl), lm = objective(&c, lam - dl);
   const double curv = dof * (lp - 2.0 * l0 + lm) / (dl * dl);
   if (!isfinite(l0) || !isfinite(curv)) return HM_ENOCONV;
@@ -130,5 +145,7 @@ hm_status hm_spectrum_fit_conicity(hm_mode_model m, double speed_kmh, const hm_s
   out->motion_rms_m = motion[0];
   out->neg2_log_lik = dof * l0;
   out->bins = n;
+  out->deviance_per_bin = dev / (double)n;
+  out->shape_chi2 = shape;
   return HM_OK;
 }

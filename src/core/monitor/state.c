@@ -113,6 +113,7 @@ uint64_t hm_state_hash(const hm_monitor_config *cfg, const hm_vehicle *veh) {
     h = fnv_f64(h, g->spectrum_low_hz);
     h = fnv_f64(h, g->spectrum_high_hz);
     h = fnv_f64(h, g->spectrum_model_error);
+    h = fnv_f64(h, g->spectrum_max_shape_chi2);
   }
   return h;
 }
