@@ -111,11 +111,13 @@ typedef struct {
   double spectrum_low_hz, spectrum_high_hz;
   double spectrum_model_error;
   double spectrum_max_shape_chi2;
+  int spectrum_conicity;         /* 1: the window's conicity is the spectrum's; 0: the fit only tests the window (its
+                                    shape), the conicity stays the mode's reading's */
 } hm_margin_config;
 
 /* Defaults: 1%, 5%, 12 km/h, 200 km/h, 900 s, 20 km/h, 150 km/h, z = 2 (about 95%), misfit chi2 9 (3 standard
  * errors), change at 4 standard errors, the spectrum's conicity off (its error 2%, its shape's chi2 at most 30, when
- * set). */
+ * set, and taken as the window's conicity). */
 void hm_margin_config_default(hm_margin_config *cfg);
 hm_status hm_margin_config_validate(const hm_margin_config *cfg, char *why, size_t why_len);
 

@@ -197,12 +197,13 @@ static void monitor_settings(void) {
   char err[256] = "";
   HM_CHECK(hm_config_load_monitor(HM_SOURCE_DIR "/config/monitor.yaml", &m, err, sizeof err) == HM_OK, "%s", err);
   HM_CHECK(memcmp(&m, &d, sizeof m) == 0, "config/monitor.yaml differs from the defaults");
-  for (int k = 0; k < 2; ++k) { /* the bogie's sensors: the model's spectrum fitted over 6-22 and 4-22 Hz */
+  for (int k = 0; k < 2; ++k) { /* the bogie's sensors: the model's spectrum a test at the axle box, the conicity at the frame */
     hm_monitor_config s = d;
     const char *path = k ? HM_SOURCE_DIR "/config/monitor_bogie_frame.yaml" : HM_SOURCE_DIR "/config/monitor_bogie_axlebox.yaml";
     HM_CHECK(hm_config_load_monitor(path, &s, err, sizeof err) == HM_OK, "%s", err);
     HM_CHECK(s.margin.spectrum_low_hz == (k ? 4.0 : 6.0) && s.margin.spectrum_high_hz == 22.0 &&
-                 s.margin.spectrum_model_error == 0.02, "%s: the spectrum's band", path);
+                 s.margin.spectrum_conicity == k && s.margin.spectrum_model_error == 0.02,
+             "%s: the spectrum's band", path);
   }
   const char *bogie = "estimator:\n  rms_limit_mps2: 6\n  measurement_point: bogie_frame\n";
   hm_monitor_config b = d;

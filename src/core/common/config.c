@@ -517,6 +517,7 @@ static const settings_field margin_fields[] = {
     MAR(max_misfit_chi2, FIELD_DOUBLE),       MAR(change_z, FIELD_DOUBLE),
     MAR(spectrum_low_hz, FIELD_DOUBLE),       MAR(spectrum_high_hz, FIELD_DOUBLE),
     MAR(spectrum_model_error, FIELD_DOUBLE),  MAR(spectrum_max_shape_chi2, FIELD_DOUBLE),
+    MAR(spectrum_conicity, FIELD_BOOL),
 };
 
 static const settings_field alarm_fields[] = {

@@ -75,6 +75,7 @@ void hm_margin_config_default(hm_margin_config *c) {
   c->spectrum_low_hz = c->spectrum_high_hz = 0.0;
   c->spectrum_model_error = 0.02;
   c->spectrum_max_shape_chi2 = 30.0;
+  c->spectrum_conicity = 1;
 }
 
 hm_status hm_margin_config_validate(const hm_margin_config *c, char *why, size_t len) {
@@ -93,7 +94,8 @@ hm_status hm_margin_config_validate(const hm_margin_config *c, char *why, size_t
       {"spectrum_low_hz", c->spectrum_low_hz, HM_RULE_OFF_OR_RANGE, 0.5, 200.0},
       {"spectrum_high_hz", c->spectrum_high_hz, HM_RULE_OFF_OR_RANGE, 1.0, 500.0},
       {"spectrum_model_error", c->spectrum_model_error, HM_RULE_RANGE, 0.0, 0.5},
-      {"spectrum_max_shape_chi2", c->spectrum_max_shape_chi2, HM_RULE_RANGE, 1.0, 1e6}};
+      {"spectrum_max_shape_chi2", c->spectrum_max_shape_chi2, HM_RULE_RANGE, 1.0, 1e6},
+      {"spectrum_conicity", (double)c->spectrum_conicity, HM_RULE_FLAG, 0.0, 0.0}};
   const hm_status st = hm_check_fields(f, HM_COUNT_OF(f), why, len);
   if (st != HM_OK) return st;
   if ((c->spectrum_low_hz == 0.0) != (c->spectrum_high_hz == 0.0) ||
@@ -265,13 +267,17 @@ static hm_window_verdict prepare_reading(const hm_margin m, double t_end, double
  * spectrum_model_error of the conicity (the model's own spectrum fitted back over a bogie frame's 4-22 Hz scattered by
  * 1.2% 30 km/h below the Hopf speed, where the curvature gave 0.5%: docs/VEHICLES.md). Where the model misses the
  * spectrum's shape (shape_chi2 above spectrum_max_shape_chi2: a vehicle that is not the model, whose frame's spectrum
- * a wrong conicity would be made to explain) the window is a misfit: HM_WINDOW_MISFIT, else v unchanged. */
+ * a wrong conicity would be made to explain) the window is a misfit: HM_WINDOW_MISFIT, else v unchanged; with
+ * spectrum_conicity 0 that test is all the fit does (an axle box, where a description whose frame is off still
+ * explains the wheelsets' spectrum and the spectrum's narrow interval would hold a Hopf speed the description has
+ * wrong: docs/VEHICLES.md). */
 static hm_window_verdict use_spectrum(const hm_margin m, const hm_mode_estimate *mode, window *w, hm_window_verdict v) {
   if (v != HM_WINDOW_USED || mode->narrow_peak || !reads_by_model(m) || !(m->cfg.spectrum_high_hz > 0.0) ||
       !mode->spectrum_valid || !(mode->spectrum_conicity > 0.0) || !(mode->spectrum_conicity_se > 0.0) ||
       !isfinite(mode->spectrum_conicity_se))
     return v;
   if (!(mode->spectrum_shape_chi2 <= m->cfg.spectrum_max_shape_chi2)) return HM_WINDOW_MISFIT;
+  if (!m->cfg.spectrum_conicity) return v; /* (the test alone) */
   w->lambda = mode->spectrum_conicity;
   w->lambda_stat = mode->spectrum_conicity_se;
   w->lambda_sys = m->cfg.spectrum_model_error * mode->spectrum_conicity;

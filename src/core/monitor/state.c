@@ -114,6 +114,7 @@ uint64_t hm_state_hash(const hm_monitor_config *cfg, const hm_vehicle *veh) {
     h = fnv_f64(h, g->spectrum_high_hz);
     h = fnv_f64(h, g->spectrum_model_error);
     h = fnv_f64(h, g->spectrum_max_shape_chi2);
+    h = fnv_u64(h, (uint64_t)(int64_t)g->spectrum_conicity);
   }
   return h;
 }
