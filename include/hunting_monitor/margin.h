@@ -115,6 +115,11 @@ typedef struct {
                                     shape), the conicity stays the mode's reading's */
 } hm_margin_config;
 
+/* The least share of a window's fitted spectral power the model must carry (spectrum_fit.h's model_share), the rest
+ * the sensor's white floor: a review's white noise was fitted with conicities of 0.03-0.24 and a shape's chi2 of 3-8
+ * (the floor explaining it; the model's share 1e-4 to 0.3); the model's own recordings carry 0.9 and more. */
+#define HM_MARGIN_SPECTRUM_MIN_SHARE 0.5
+
 /* Defaults: 1%, 5%, 12 km/h, 200 km/h, 900 s, 20 km/h, 150 km/h, z = 2 (about 95%), misfit chi2 9 (3 standard
  * errors), change at 4 standard errors, the spectrum's conicity off (its error 2%, its shape's chi2 at most 30, when
  * set, and taken as the window's conicity). */

@@ -204,11 +204,11 @@ typedef struct {
   double speed_tracking, speed_tracking_se;
   /* set by the caller with a vehicle model (monitor.h; spectrum_fit.h), 0 from the fit: the conicity whose spectrum at
    * the sensor explains the window's (margin.h's spectrum band), its standard error, the one the model at rest would
-   * have read, the leading wheelset's rms displacement from the track the fit implies [m], and the fit's shape against
-   * the spectrum's (spectrum_fit.h's shape_chi2) */
-  int spectrum_valid;
+   * have read, the leading wheelset's rms displacement from the track the fit implies [m], the fit's shape against
+   * the spectrum's (spectrum_fit.h's shape_chi2) and the model's share of the fitted power */
+  int spectrum_valid;           /* 1 fitted, 0 not asked, -1 asked and failed (no spectrum, or no fit: a misfit) */
   double spectrum_conicity, spectrum_conicity_se, spectrum_conicity_at_rest, spectrum_motion_rms_m;
-  double spectrum_shape_chi2;
+  double spectrum_shape_chi2, spectrum_model_share;
 } hm_mode_estimate;
 
 /* The window's halves' speeds must differ by at least this in ln(V2 / V1) for speed_tracking: a line then moves 1% of
@@ -275,8 +275,9 @@ double hm_modal_filter_power_gain(const void *modal, double f_hz);
  * [low_hz, high_hz] without the bins set aside for lines, as the sensor's two-sided acceleration density [(m/s^2)^2 /
  * Hz] (|X_k|^2 / (n fd), the filters' power gain divided out; bins below HM_MODAL_SPECTRUM_MIN_GAIN left out), at most
  * cap bins into f_hz[] and psd[]; *n the bins, *dof each one's degrees of freedom (2 n / nfft: the zero padding's
- * bins are not independent), *window_s the window's length [s]. HM_EDOMAIN for a band outside (0, fd / 2),
- * HM_ENOCONV where no window is kept (no fit yet, or since a reset) or the band holds fewer than 8 bins. */
+ * bins are not independent), *window_s the window's length [s]. HM_EDOMAIN for a band outside (0, fd / 2) or more
+ * bins than cap, HM_ENOCONV where no window is kept (no fit yet, or since a reset) or the band holds fewer than 8
+ * bins; the outputs untouched then. */
 hm_status hm_modal_window_spectrum(const hm_modal m, double low_hz, double high_hz, double *f_hz, double *psd,
                                    size_t cap, size_t *n, double *dof, double *window_s);
 

@@ -8,9 +8,10 @@
  * the conicity apart).
  * The model's spectrum is linearised at rest first; with passes > 0 the fit is repeated linearised about the motion of
  * the wheelsets the previous fit implies (hm_mode_model_motion_rms from its factor: Gaussian equivalent linearisation,
- * hm_running). At rest MODEL.md's flange force has no slope; at 1 mm of random motion its mean slope softens the
- * wheelsets' lateral support by about 0.5 MN/m, and a fit at rest reads the default bogie's conicity 5-10% low (its
- * Hopf speed 15-30 km/h high) 30 km/h below the Hopf speed (docs/VEHICLES.md).
+ * hm_running) until it settles. At rest MODEL.md's flange force has no slope; at 1 mm of random motion its mean slope
+ * softens the wheelsets' lateral support by about 0.5 MN/m, and a fit at rest read the default bogie's frame 2.4% low
+ * 30 km/h below the Hopf speed (0.1326 for 0.1358, test_spectrum_fit) and the strong yaw dampers' 6% low (0.1273,
+ * docs/VEHICLES.md).
  * The measured spectrum is a two-sided density [(m/s^2)^2 / Hz] of the sensor's acceleration (any filter's power gain
  * divided out, so that the factor and the motion are absolute), each bin with dof degrees of freedom (2 for one
  * periodogram, 2 / padding for a zero-padded one, 2 K for a mean of K). Nothing is allocated (at most
@@ -31,15 +32,20 @@ extern "C" {
 #define HM_SPECTRUM_FIT_MAX_BINS 4096
 #define HM_SPECTRUM_FIT_MAX_PASSES 8
 #define HM_SPECTRUM_FIT_SHAPE_PARTS 8
+/* The linearisation has settled when the motion it was made about and the one its fit implies agree to this
+ * (relative); the default bogie's frame at 1 mm settles in 2-3 passes, at 1.6 mm (irregularity 1) in 4 (a review's: 2
+ * passes had left it 3% of the conicity off) */
+#define HM_SPECTRUM_FIT_MOTION_TOL 0.01
 
 typedef struct {
   double conicity_min, conicity_max; /* the search's range, 0 < min < max */
   double tol;                        /* the golden section's final bracket [conicity], > 0 */
   double window_s;                   /* the periodogram's window [s] for the poles' leakage (0: none, a long mean) */
-  unsigned passes;                   /* linearisations about the motion found, 0..HM_SPECTRUM_FIT_MAX_PASSES */
+  unsigned passes;                   /* linearisations about the motion found at most, 0..HM_SPECTRUM_FIT_MAX_PASSES
+                                        (0: at rest only); they stop where the motion settles */
 } hm_spectrum_fit_options;
 
-/* 0.02-0.8, tol 1e-4 (a tenth of the least standard error seen), no leakage, 2 passes. */
+/* 0.02-0.8, tol 1e-4 (a tenth of the least standard error seen), no leakage, HM_SPECTRUM_FIT_MAX_PASSES passes. */
 void hm_spectrum_fit_options_default(hm_spectrum_fit_options *o);
 
 typedef struct {
@@ -55,11 +61,16 @@ typedef struct {
                                     mean of x against 1 in its standard error sqrt(2 / (dof m)), squared and summed:
                                     about chi2 with 5 degrees of freedom (8 parts less the 3 fitted) where the model's
                                     shape is the spectrum's, far more where it is not */
+  double model_share;            /* of the fitted spectrum's power over the bins, the model's (the rest the white
+                                    floor's): near 0 where the floor explains the band (noise, or a sensor that sees
+                                    none of the model's motion), whatever the conicity and the shape's chi2 say */
 } hm_spectrum_fit;
 
-/* The conicity whose spectrum at the point explains psd[] at f_hz[] (n bins, each > 0 and finite) best at the speed
- * [km/h]. HM_EDOMAIN for bad input (n below 8 or above HM_SPECTRUM_FIT_MAX_BINS, dof below 2 / 64, options out of
- * range), HM_ENOCONV where the minimum lies at the range's edge or no conicity gives a spectrum; out untouched then. */
+/* The conicity whose spectrum at the point explains psd[] at f_hz[] (n bins, each > 0 and finite, the frequencies
+ * rising) best at the speed [km/h]. HM_EDOMAIN for bad input (n below 4 HM_SPECTRUM_FIT_SHAPE_PARTS or above
+ * HM_SPECTRUM_FIT_MAX_BINS, dof below 2 / 64, options out of range), HM_ENOCONV where a pass's minimum lies at its
+ * range's edge (the whole range, or 1 / 1.5 to 1.5 times the conicity before it), no conicity gives a spectrum, or the
+ * linearisation did not settle within the passes; out untouched then. */
 hm_status hm_spectrum_fit_conicity(hm_mode_model m, double speed_kmh, const hm_sensor_point *point, const double *f_hz,
                                    const double *psd, size_t n, double dof, const hm_spectrum_fit_options *o,
                                    hm_spectrum_fit *out);

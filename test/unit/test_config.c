@@ -231,6 +231,8 @@ static void monitor_settings(void) {
       {"margin:\n  spectrum_low_hz: 6\n  spectrum_high_hz: 10\n", "else at least twice it (got 10)", HM_EDOMAIN},
       {"margin:\n  spectrum_low_hz: 0.1\n  spectrum_high_hz: 10\n", "margin.spectrum_low_hz: must be 0 (off) or in",
        HM_EDOMAIN},
+      {"margin:\n  spectrum_low_hz: 6\n  spectrum_high_hz: 60\n",
+       "margin.spectrum_high_hz: must be below half modal.decimated_rate_hz (got 60)", HM_EDOMAIN},
       {"track_lines:\n  min_speed_change_rel: 0.01\n", "track_lines.min_speed_change_rel: must be in [0.02, 0.5]",
        HM_EDOMAIN},
       {"track_lines:\n  wavelength: 0.01\n", "track_lines.wavelength: unknown key", HM_EPARSE},

@@ -267,16 +267,20 @@ static hm_window_verdict prepare_reading(const hm_margin m, double t_end, double
  * spectrum_model_error of the conicity (the model's own spectrum fitted back over a bogie frame's 4-22 Hz scattered by
  * 1.2% 30 km/h below the Hopf speed, where the curvature gave 0.5%: docs/VEHICLES.md). Where the model misses the
  * spectrum's shape (shape_chi2 above spectrum_max_shape_chi2: a vehicle that is not the model, whose frame's spectrum
- * a wrong conicity would be made to explain) the window is a misfit: HM_WINDOW_MISFIT, else v unchanged; with
+ * a wrong conicity would be made to explain), where the model carries less than HM_MARGIN_SPECTRUM_MIN_SHARE of the
+ * fitted power (the white floor explains the band: noise fits any conicity) or where the fit failed, the window is a
+ * misfit: HM_WINDOW_MISFIT, else v unchanged; with
  * spectrum_conicity 0 that test is all the fit does (an axle box, where a description whose frame is off still
  * explains the wheelsets' spectrum and the spectrum's narrow interval would hold a Hopf speed the description has
  * wrong: docs/VEHICLES.md). */
 static hm_window_verdict use_spectrum(const hm_margin m, const hm_mode_estimate *mode, window *w, hm_window_verdict v) {
   if (v != HM_WINDOW_USED || mode->narrow_peak || !reads_by_model(m) || !(m->cfg.spectrum_high_hz > 0.0) ||
-      !mode->spectrum_valid || !(mode->spectrum_conicity > 0.0) || !(mode->spectrum_conicity_se > 0.0) ||
-      !isfinite(mode->spectrum_conicity_se))
+      mode->spectrum_valid == 0)
     return v;
-  if (!(mode->spectrum_shape_chi2 <= m->cfg.spectrum_max_shape_chi2)) return HM_WINDOW_MISFIT;
+  if (mode->spectrum_valid < 0 || !(mode->spectrum_conicity > 0.0) || !(mode->spectrum_conicity_se > 0.0) ||
+      !isfinite(mode->spectrum_conicity_se) || !(mode->spectrum_model_share >= HM_MARGIN_SPECTRUM_MIN_SHARE) ||
+      !(mode->spectrum_shape_chi2 <= m->cfg.spectrum_max_shape_chi2))
+    return HM_WINDOW_MISFIT;
   if (!m->cfg.spectrum_conicity) return v; /* (the test alone) */
   w->lambda = mode->spectrum_conicity;
   w->lambda_stat = mode->spectrum_conicity_se;

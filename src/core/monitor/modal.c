@@ -147,13 +147,17 @@ hm_status hm_modal_window_spectrum(const hm_modal m, double low_hz, double high_
   if (m->spec_n == 0) return HM_ENOCONV;
   const double df = m->fd / (double)m->spec_nfft, norm = (double)m->spec_n * m->fd;
   size_t nb = 0;
-  for (size_t k = (size_t)ceil(low_hz / df); (double)k * df <= high_hz && k <= m->spec_nfft / 2 && nb < cap; ++k) {
-    const double f = (double)k * df, gain = hm_modal_filter_power_gain(m, f);
-    if (m->spec_mask[k] || !(gain >= HM_MODAL_SPECTRUM_MIN_GAIN) || !(m->spec[k] > 0.0)) continue;
-    f_hz[nb] = f;
-    psd[nb++] = m->spec[k] / norm / gain;
+  for (int write = 0; write < 2; ++write) { /* counted first: the outputs untouched on a failure */
+    nb = 0;
+    for (size_t k = (size_t)ceil(low_hz / df); (double)k * df <= high_hz && k <= m->spec_nfft / 2; ++k) {
+      const double f = (double)k * df, gain = hm_modal_filter_power_gain(m, f);
+      if (m->spec_mask[k] || !(gain >= HM_MODAL_SPECTRUM_MIN_GAIN) || !(m->spec[k] > 0.0)) continue;
+      if (write) f_hz[nb] = f, psd[nb] = m->spec[k] / norm / gain;
+      ++nb;
+    }
+    if (nb < 8) return HM_ENOCONV;
+    if (nb > cap) return HM_EDOMAIN;
   }
-  if (nb < 8) return HM_ENOCONV;
   *n = nb;
   *dof = 2.0 * (double)m->spec_n / (double)m->spec_nfft;
   *window_s = (double)m->spec_n / m->fd;

@@ -612,7 +612,8 @@ static const double GH_W[5] = {0.019953242059046, 0.393619323152241, 0.945308720
 static hm_status linearised(const hm_system *sys, double v, const double *motion_rms_m, double *jac,
                             double (*B)[NMAX]) {
   const size_t d = sys->dim, nw = sys->n_wheelsets;
-  const int moving = motion_rms_m != NULL;
+  int moving = 0;
+  for (size_t i = 0; motion_rms_m && i < nw; ++i) moving = moving || motion_rms_m[i] > 0.0;
   const int nq = moving ? 5 : 1;
   const double h = 1e-7;
   memset(jac, 0, d * d * sizeof jac[0]);
@@ -640,9 +641,11 @@ static hm_status linearised(const hm_system *sys, double v, const double *motion
 static hm_status sensor_spectrum(hm_mode_model m, double conicity, double speed_kmh, const hm_sensor_point *point,
                                  const double *f_hz, size_t n, double shift, const double *motion_rms_m,
                                  double *shape, double *motion_out) {
-  if (!m || !point || !f_hz || !shape || n == 0 || !(speed_kmh > 0.0) || !isfinite(speed_kmh) ||
-      !isfinite(conicity) || conicity < 0.0)
+  if (!m || !point || !f_hz || !shape || n == 0 || n > HM_MODE_MODEL_SPECTRUM_MAX_BINS || !(speed_kmh > 0.0) ||
+      !isfinite(speed_kmh) || !isfinite(conicity) || conicity < 0.0)
     return HM_EDOMAIN;
+  for (size_t k = 0; k < n; ++k)
+    if (!(f_hz[k] > 0.0) || !isfinite(f_hz[k])) return HM_EDOMAIN;
   hm_status st = set_conicity(m, conicity);
   if (st != HM_OK) return st;
   const hm_system *sys = &m->sys;
@@ -651,9 +654,9 @@ static hm_status sensor_spectrum(hm_mode_model m, double conicity, double speed_
   const double v = hm_mps_from_kmh(speed_kmh);
   double jac[NMAX * NMAX], B[HM_SYSTEM_MAX_WHEELSETS][NMAX];
   if ((st = linearised(sys, v, motion_rms_m, jac, B)) != HM_OK) return st;
+  double out[HM_MODE_MODEL_SPECTRUM_MAX_BINS]; /* (shape untouched on a failure) */
   for (size_t k = 0; k < n; ++k) {
     const double w = 2.0 * HM_PI * f_hz[k];
-    if (!(w > 0.0) || !isfinite(w)) return HM_EDOMAIN;
     double _Complex a[NMAX * NMAX], u[NMAX];
     for (size_t r = 0; r < d; ++r) {
       u[r] = 0.0;
@@ -673,13 +676,14 @@ static hm_status sensor_spectrum(hm_mode_model m, double conicity, double speed_
     double _Complex acc = 0.0; /* the point's sum of accelerations: rows of i w X (= A X + B u) */
     for (size_t j = 0; j < point->n_terms; ++j) acc += point->weight[j] * (I * w + shift) * x[point->state[j]];
     const double S = hm_track_alignment_psd(w / v) / v;
-    shape[k] = creal(acc * conj(acc)) * S;
-    if (!isfinite(shape[k])) return HM_ENONFINITE;
+    out[k] = creal(acc * conj(acc)) * S;
+    if (!isfinite(out[k])) return HM_ENONFINITE;
     for (size_t i = 0; motion_out && i < nw; ++i) { /* wheelset i's displacement from the track under it */
       const double _Complex r = x[sys->wheelset_y_state[i]] - ua[i];
       motion_out[i * n + k] = creal(r * conj(r)) * S;
     }
   }
+  memcpy(shape, out, n * sizeof shape[0]);
   return HM_OK;
 }
 

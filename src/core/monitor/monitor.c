@@ -78,6 +78,10 @@ hm_status hm_monitor_config_validate(const hm_monitor_config *c, char *why, size
   if (st == HM_OK) st = prefixed(hm_margin_config_validate(&c->margin, why, len), "margin", why, len);
   if (st == HM_OK) st = prefixed(hm_alarm_config_validate(&c->alarm, why, len), "alarm", why, len);
   if (st == HM_OK) st = hm_track_lines_config_validate(&c->track_lines, why, len); /* "track_lines." prefixed */
+  /* the spectrum's band within the identification's decimated signal (modal.h: its Nyquist at least the rate asked) */
+  if (st == HM_OK && c->margin.spectrum_high_hz > 0.0 && !(c->margin.spectrum_high_hz < 0.5 * c->modal.decimated_rate_hz))
+    st = hm_reject(why, len, "margin.spectrum_high_hz", "must be below half modal.decimated_rate_hz",
+                   c->margin.spectrum_high_hz);
   if (st != HM_OK) return st;
   const hm_field_check f[] = {{"table_n_conicity", (double)c->table_n_conicity, HM_RULE_RANGE, 2.0, 1000.0},
                               {"table.tolerance_kmh", c->table.tolerance_kmh, HM_RULE_POSITIVE, 0.0, 0.0},
@@ -314,6 +318,7 @@ static void track_lines_of(hm_monitor m, double t, double v, hm_mode_estimate *m
 static void spectrum_of(hm_monitor m, double t, double stretch_start, int full, hm_mode_estimate *e) {
   e->spectrum_valid = 0;
   if (!m->spec_f || !e->valid || e->narrow_peak) return;
+  e->spectrum_valid = -1; /* (until a fit succeeds: a window asked for and not fitted is a misfit, margin.h) */
   if (!full && m->spec_last.spectrum_valid && fabs(m->spec_stretch - stretch_start) < 0.5 && t - m->spec_at >= 0.0 &&
       t - m->spec_at < HM_MONITOR_SPECTRUM_EVERY_S) {
     e->spectrum_valid = 1;
@@ -322,6 +327,7 @@ static void spectrum_of(hm_monitor m, double t, double stretch_start, int full, 
     e->spectrum_conicity_at_rest = m->spec_last.spectrum_conicity_at_rest;
     e->spectrum_motion_rms_m = m->spec_last.spectrum_motion_rms_m;
     e->spectrum_shape_chi2 = m->spec_last.spectrum_shape_chi2;
+    e->spectrum_model_share = m->spec_last.spectrum_model_share;
     return;
   }
   size_t n;
@@ -341,6 +347,7 @@ static void spectrum_of(hm_monitor m, double t, double stretch_start, int full, 
   e->spectrum_conicity_at_rest = fit.conicity_at_rest;
   e->spectrum_motion_rms_m = fit.motion_rms_m;
   e->spectrum_shape_chi2 = fit.shape_chi2;
+  e->spectrum_model_share = fit.model_share;
   m->spec_last = *e;
   m->spec_at = t;
   m->spec_stretch = stretch_start;

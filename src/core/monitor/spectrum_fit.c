@@ -12,7 +12,7 @@ void hm_spectrum_fit_options_default(hm_spectrum_fit_options *o) {
   o->conicity_max = 0.8;
   o->tol = 1e-4;
   o->window_s = 0.0;
-  o->passes = 2;
+  o->passes = HM_SPECTRUM_FIT_MAX_PASSES;
 }
 
 /* sum_k p_k / m_k + ln m_k with m_k = a g_k + c, a and c > 0 chosen to minimise it (-log L per degree of freedom
@@ -96,18 +96,22 @@ static int options_ok(const hm_spectrum_fit_options *o) {
 hm_status hm_spectrum_fit_conicity(hm_mode_model m, double speed_kmh, const hm_sensor_point *point, const double *f_hz,
                                    const double *psd, size_t n, double dof, const hm_spectrum_fit_options *o,
                                    hm_spectrum_fit *out) {
-  if (!m || !point || !f_hz || !psd || !out || !options_ok(o) || n < 8 || n > HM_SPECTRUM_FIT_MAX_BINS ||
-      !(dof >= 2.0 / 64.0) || !isfinite(dof) || n < 4 * HM_SPECTRUM_FIT_SHAPE_PARTS || !(speed_kmh > 0.0) || !isfinite(speed_kmh))
+  if (!m || !point || !f_hz || !psd || !out || !options_ok(o) || n < 4 * HM_SPECTRUM_FIT_SHAPE_PARTS ||
+      n > HM_SPECTRUM_FIT_MAX_BINS || !(dof >= 2.0 / 64.0) || !isfinite(dof) || !(speed_kmh > 0.0) ||
+      !isfinite(speed_kmh))
     return HM_EDOMAIN;
   for (size_t k = 0; k < n; ++k)
-    if (!(psd[k] > 0.0) || !isfinite(psd[k]) || !(f_hz[k] > 0.0) || !isfinite(f_hz[k])) return HM_EDOMAIN;
+    if (!(psd[k] > 0.0) || !isfinite(psd[k]) || !(f_hz[k] > 0.0) || !isfinite(f_hz[k]) ||
+        (k > 0 && !(f_hz[k] > f_hz[k - 1])))
+      return HM_EDOMAIN;
   double g[HM_SPECTRUM_FIT_MAX_BINS];
   hm_running run;
   memset(&run, 0, sizeof run);
   run.window_s = o->window_s;
   fit_ctx c = {m, speed_kmh, point, &run, f_hz, psd, n, g, 0.0, 0.0};
   double lam, at_rest = NAN, motion[HM_SYSTEM_MAX_WHEELSETS] = {0.0};
-  for (unsigned pass = 0; pass <= o->passes; ++pass) {
+  const size_t nw = HM_SYSTEM_MAX_WHEELSETS;
+  for (unsigned pass = 0;; ++pass) {
     /* the first over the range; each later one about the conicity before it (the motion changes it by 5-10%) */
     const int ok = pass == 0 ? minimise(&c, o->conicity_min, o->conicity_max, SCAN, o->tol, &lam)
                              : minimise(&c, fmax(lam / 1.5, o->conicity_min), fmin(lam * 1.5, o->conicity_max),
@@ -116,13 +120,24 @@ hm_status hm_spectrum_fit_conicity(hm_mode_model m, double speed_kmh, const hm_s
     if (pass == 0) at_rest = lam;
     if (!isfinite(objective(&c, lam))) return HM_ENOCONV;
     if (hm_mode_model_motion_rms(m, lam, speed_kmh, &run, c.amp, motion) != HM_OK) return HM_ENOCONV;
-    if (pass < o->passes) memcpy(run.motion_rms_m, motion, sizeof motion);
+    if (pass == o->passes) break;
+    /* converged: the motion linearised about and the one found within HM_SPECTRUM_FIT_MOTION_TOL of each other */
+    int settled = pass > 0;
+    for (size_t i = 0; i < nw; ++i)
+      settled = settled && fabs(motion[i] - run.motion_rms_m[i]) <= HM_SPECTRUM_FIT_MOTION_TOL * motion[i];
+    if (settled) break;
+    memcpy(run.motion_rms_m, motion, sizeof motion);
+  }
+  if (o->passes > 0) { /* not settled within the passes: no conicity (a motion this large is no Gaussian's either) */
+    for (size_t i = 0; i < nw; ++i)
+      if (fabs(motion[i] - run.motion_rms_m[i]) > HM_SPECTRUM_FIT_MOTION_TOL * motion[i]) return HM_ENOCONV;
   }
   const double l0 = objective(&c, lam), amp = c.amp, fl = c.floor_;
-  double dev = 0.0; /* Whittle's deviance: 2 sum (x - ln x - 1), x = p / m, at the minimum */
+  double dev = 0.0, carried = 0.0, total = 0.0; /* Whittle's deviance: 2 sum (x - ln x - 1), x = p / m */
   for (size_t k = 0; k < n; ++k) {
     const double x = psd[k] / (amp * g[k] + fl);
     dev += 2.0 * (x - log(x) - 1.0);
+    carried += amp * g[k], total += amp * g[k] + fl;
   }
   /* the fit's shape against the spectrum's: the mean of x over each of SHAPE_PARTS equal parts of the bins is 1 within
    * sqrt(2 / (dof m)) where the model explains them (x of m bins of dof / 2 periodograms each); their chi2 */
@@ -147,5 +162,6 @@ hm_status hm_spectrum_fit_conicity(hm_mode_model m, double speed_kmh, const hm_s
   out->bins = n;
   out->deviance_per_bin = dev / (double)n;
   out->shape_chi2 = shape;
+  out->model_share = carried / total;
   return HM_OK;
 }
