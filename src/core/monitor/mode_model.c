@@ -583,10 +583,8 @@ hm_status hm_mode_model_motion_rms(hm_mode_model m, double conicity, double spee
   double f[MOTION_GRID], shape[MOTION_GRID], mot[HM_SYSTEM_MAX_WHEELSETS * MOTION_GRID];
   const double f_lo = v / MOTION_WL_MAX_M, f_hi = v / MOTION_WL_MIN_M, dl = log(f_hi / f_lo) / (MOTION_GRID - 1);
   for (size_t k = 0; k < MOTION_GRID; ++k) f[k] = f_lo * exp(dl * (double)k);
-  hm_status st = set_conicity(m, conicity);
-  if (st != HM_OK) return st;
-  const hm_sensor_point any = {1, {m->sys.wheelset_y_state[0] + 1}, {1.0}};
-  st = sensor_spectrum(m, conicity, speed_kmh, &any, f, MOTION_GRID, 0.0, run->motion_rms_m, shape, mot);
+  const hm_sensor_point any = {1, {m->sys.wheelset_y_state[0] + 1}, {1.0}}; /* (sensor_spectrum sets the conicity) */
+  const hm_status st = sensor_spectrum(m, conicity, speed_kmh, &any, f, MOTION_GRID, 0.0, run->motion_rms_m, shape, mot);
   if (st != HM_OK) return st;
   for (size_t i = 0; i < m->sys.n_wheelsets; ++i) {
     double var = 0.0;

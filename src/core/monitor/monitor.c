@@ -45,7 +45,7 @@ struct hm_monitor_s {
   double large_at;               /* the latest update that saw a large oscillation (-inf: none) */
   hm_sensor_point sensor;        /* a model's sensor, whose spectrum a window's is fitted by (margin.spectrum_*_hz) */
   double *spec_f, *spec_p;       /* that fit's bins (HM_SPECTRUM_FIT_MAX_BINS each; NULL: no such fit) */
-  hm_mode_estimate spec_last;    /* the last such fit's fields (spectrum_*), its time and where its data began */
+  hm_spectrum_fit spec_last;     /* the last such fit (spec_at NAN: none), its time and where its data began */
   double spec_at, spec_stretch;
 };
 
@@ -182,16 +182,15 @@ hm_status hm_monitor_create_model(const hm_monitor_config *cfg, hm_model_kind ki
   if (st == HM_OK && model) {
     st = hm_mode_model_set_band(model, cfg->modal.band_low_hz, cfg->modal.band_high_hz);
     /* the identified mode is compared with what the same reading gives on the model at the sensor (mode_model.h) */
-    if (st == HM_OK)
-      st = hm_mode_model_set_sensor(model, cfg->estimator.measurement_point == HM_POINT_BOGIE_FRAME ? "frame" : "axlebox");
+    const char *where = cfg->estimator.measurement_point == HM_POINT_BOGIE_FRAME ? "frame" : "axlebox";
+    if (st == HM_OK) st = hm_mode_model_set_sensor(model, where);
     hm_mode_model_set_reading_gain(model, hm_modal_filter_power_gain, m->modal);
+    m->spec_at = NAN; /* (no spectrum fitted yet) */
     if (st == HM_OK && cfg->margin.spectrum_high_hz > 0.0) { /* the spectrum's fit (margin.h) */
       m->spec_f = malloc(HM_SPECTRUM_FIT_MAX_BINS * sizeof(double));
       m->spec_p = malloc(HM_SPECTRUM_FIT_MAX_BINS * sizeof(double));
       st = m->spec_f && m->spec_p ? HM_OK : HM_ENOMEM;
-      if (st == HM_OK)
-        st = hm_mode_model_sensor(model, cfg->estimator.measurement_point == HM_POINT_BOGIE_FRAME ? "frame" : "axlebox",
-                                  &m->sensor);
+      if (st == HM_OK) st = hm_mode_model_sensor(model, where, &m->sensor);
     }
     hm_margin_set_model(m->margin, model);
     if (st == HM_OK) st = hm_alarm_set_model(m->alarm, model);
@@ -319,38 +318,32 @@ static void spectrum_of(hm_monitor m, double t, double stretch_start, int full, 
   e->spectrum_valid = 0;
   if (!m->spec_f || !e->valid || e->narrow_peak) return;
   e->spectrum_valid = -1; /* (until a fit succeeds: a window asked for and not fitted is a misfit, margin.h) */
-  if (!full && m->spec_last.spectrum_valid && fabs(m->spec_stretch - stretch_start) < 0.5 && t - m->spec_at >= 0.0 &&
-      t - m->spec_at < HM_MONITOR_SPECTRUM_EVERY_S) {
-    e->spectrum_valid = 1;
-    e->spectrum_conicity = m->spec_last.spectrum_conicity;
-    e->spectrum_conicity_se = m->spec_last.spectrum_conicity_se;
-    e->spectrum_conicity_at_rest = m->spec_last.spectrum_conicity_at_rest;
-    e->spectrum_motion_rms_m = m->spec_last.spectrum_motion_rms_m;
-    e->spectrum_shape_chi2 = m->spec_last.spectrum_shape_chi2;
-    e->spectrum_model_share = m->spec_last.spectrum_model_share;
-    return;
+  const int reuse = !full && fabs(m->spec_stretch - stretch_start) < 0.5 && t - m->spec_at >= 0.0 &&
+                    t - m->spec_at < HM_MONITOR_SPECTRUM_EVERY_S; /* (false while spec_at is NAN) */
+  if (!reuse) {
+    size_t n;
+    double dof, window_s;
+    hm_spectrum_fit_options o;
+    hm_spectrum_fit_options_default(&o);
+    m->spec_at = NAN;
+    if (hm_modal_window_spectrum(m->modal, m->cfg.margin.spectrum_low_hz, m->cfg.margin.spectrum_high_hz, m->spec_f,
+                                 m->spec_p, HM_SPECTRUM_FIT_MAX_BINS, &n, &dof, &window_s) != HM_OK)
+      return;
+    o.window_s = window_s;
+    if (hm_spectrum_fit_conicity(m->model, m->mode_speed, &m->sensor, m->spec_f, m->spec_p, n, dof, &o,
+                                 &m->spec_last) != HM_OK)
+      return;
+    m->spec_at = t;
+    m->spec_stretch = stretch_start;
   }
-  size_t n;
-  double dof, window_s;
-  hm_spectrum_fit_options o;
-  hm_spectrum_fit_options_default(&o);
-  hm_spectrum_fit fit;
-  if (hm_modal_window_spectrum(m->modal, m->cfg.margin.spectrum_low_hz, m->cfg.margin.spectrum_high_hz, m->spec_f,
-                               m->spec_p, HM_SPECTRUM_FIT_MAX_BINS, &n, &dof, &window_s) != HM_OK)
-    return;
-  o.window_s = window_s;
-  if (hm_spectrum_fit_conicity(m->model, m->mode_speed, &m->sensor, m->spec_f, m->spec_p, n, dof, &o, &fit) != HM_OK)
-    return;
+  const hm_spectrum_fit *fit = &m->spec_last;
   e->spectrum_valid = 1;
-  e->spectrum_conicity = fit.conicity;
-  e->spectrum_conicity_se = fit.conicity_se;
-  e->spectrum_conicity_at_rest = fit.conicity_at_rest;
-  e->spectrum_motion_rms_m = fit.motion_rms_m;
-  e->spectrum_shape_chi2 = fit.shape_chi2;
-  e->spectrum_model_share = fit.model_share;
-  m->spec_last = *e;
-  m->spec_at = t;
-  m->spec_stretch = stretch_start;
+  e->spectrum_conicity = fit->conicity;
+  e->spectrum_conicity_se = fit->conicity_se;
+  e->spectrum_conicity_at_rest = fit->conicity_at_rest;
+  e->spectrum_motion_rms_m = fit->motion_rms_m;
+  e->spectrum_shape_chi2 = fit->shape_chi2;
+  e->spectrum_model_share = fit->model_share;
 }
 
 /* A fit of the identification. At a steady speed (the newest stretch whose speed varied by at most the margin's

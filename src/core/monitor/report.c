@@ -99,9 +99,10 @@ static void mode_part(const hm_monitor_status *st, hm_report *r) {
   r->mode_speed_tracking = md->speed_tracking;
   r->mode_speed_tracking_se = md->speed_tracking_se;
   /* a vehicle model's fit of the whole spectrum (spectrum_fit.h; NAN where none was made for this window) */
-  r->spectrum_conicity = when(md->spectrum_valid, md->spectrum_conicity);
-  r->spectrum_conicity_se = when(md->spectrum_valid, md->spectrum_conicity_se);
-  r->spectrum_motion_rms_m = when(md->spectrum_valid, md->spectrum_motion_rms_m);
+  const int sf = md->spectrum_valid > 0; /* (-1: asked and not fitted) */
+  r->spectrum_conicity = when(sf, md->spectrum_conicity);
+  r->spectrum_conicity_se = when(sf, md->spectrum_conicity_se);
+  r->spectrum_motion_rms_m = when(sf, md->spectrum_motion_rms_m);
   r->narrow_peak = md->narrow_peak;
   r->narrow_peak_hz = when(md->narrow_peak, md->narrow_peak_hz);
   r->narrow_peak_wavelength_m = when(md->narrow_peak && md->narrow_peak_wavelength_m > 0.0,
