@@ -31,7 +31,8 @@
  *    band-passed acceleration's amplitude over whole periods, corrected for the band's gain, over (2 pi f)^2) of a
  *    coherent oscillation (period spread at most 0.2) at or above displacement_limit_m (2.1 mm, the same half of the
  *    4.2 mm cycle) at any frequency of the 2-20 Hz band: a limit that depends neither on the frequency nor on the
- *    boundary table;
+ *    boundary table; on a bogie frame with a vehicle model, the wheelsets' displacement the frame's oscillation
+ *    implies in the hunting mode's shape (hm_estimator_set_displacement_map below; config/monitor_bogie_frame.yaml);
  *    The identification of the hunting mode and the conicity are not here: modal.h, inversion.h, margin.h.
  * Sample rate: the filters are first designed for the configured sample_rate_hz, which is an expectation: the rate
  * is measured from the time stamps over blocks of 0.5 s of gap-free data: from regular stamps (a sensor's clock,
@@ -122,7 +123,7 @@ typedef struct {
   int oscillation_valid;          /* tracker settled: a full tracking time of samples and a frequency */
   double amplitude_accel_mps2;
   double frequency_hz;            /* 0 if not valid */
-  double amplitude_displacement_m;/* 0 if the frequency is not valid */
+  double amplitude_displacement_m;/* 0 if the frequency is not valid; with a displacement map (below) the wheelset's */
   double period_spread;           /* relative standard deviation of the recent periods */
   double rms_mps2;                /* sliding r.m.s. over the window (or what is available of it) */
   int rms_window_complete;
@@ -149,6 +150,16 @@ void hm_estimator_reset(hm_estimator est);
  * fields are ignored), validated as hm_estimator_config_validate does (HM_EDOMAIN with the reason; nothing changes
  * then). The stream's state is kept. */
 hm_status hm_estimator_set_limits(hm_estimator est, const hm_estimator_config *cfg, char *why, size_t why_len);
+/* The wheelset's displacement amplitude per acceleration amplitude at the sensor [m per m/s^2] at the tracked frequency
+ * and speed, or a value <= 0 or not finite where it cannot be told; a vehicle model's (mode_model.h,
+ * hm_mode_model_displacement_per_accel) for a sensor away from the axle box. */
+typedef double (*hm_displacement_map_fn)(void *ctx, double f_hz, double speed_kmh);
+/* With a map (fn not NULL) amplitude_displacement_m is the wheelset's, amp x fn(ctx, f, speed), and the displacement
+ * criterion (c) judges it (a bogie frame sees about a tenth of its wheelsets' motion at their hunting frequency, and
+ * the standards' frame limits came 3-50 s after 3 mm on a bogie that is not its description, docs/VEHICLES.md);
+ * where the map cannot tell (no valid speed, a value <= 0) the displacement is the sensor's own and (c) does not
+ * judge. NULL: the sensor's own, a / (2 pi f)^2. */
+void hm_estimator_set_displacement_map(hm_estimator est, hm_displacement_map_fn fn, void *ctx);
 /* How many times the filters restarted (gaps, redesigns for a measured rate, resets), and the rate they are designed
  * for now: a consumer of the same stream (the modal identification) restarts with them. */
 unsigned long hm_estimator_restarts(const hm_estimator est, double *design_rate_hz);

@@ -132,6 +132,19 @@ hm_status hm_mode_model_running_spectrum(hm_mode_model m, double conicity, doubl
 hm_status hm_mode_model_motion_rms(hm_mode_model m, double conicity, double speed_kmh, const hm_running *run,
                                    double amplitude, double *motion_rms_m);
 
+/* The relative band [-] around a frequency in which hm_mode_model_displacement_per_accel takes its mode. */
+#define HM_MODE_MODEL_SHAPE_BAND 0.05
+/* The wheelsets' displacement per acceleration at the sensor point [m per m/s^2] in an oscillation at f_hz (> 0): in
+ * the mode shape of the least-damped oscillatory root within HM_MODE_MODEL_SHAPE_BAND of f (the right eigenvector of
+ * the Jacobian at rest), the largest wheelset lateral displacement over the point's acceleration (lambda times its
+ * velocity states). A self-excited oscillation is that mode's (hunting is its limit cycle: the shape near the Hopf
+ * point's), not the track's forced response, whose wheelsets meet the track 2b / v apart: from a bogie frame's
+ * hunting it reads the wheelsets' amplitude (estimator.h's displacement map). *out untouched on a failure
+ * (HM_EDOMAIN for a speed or frequency not > 0 and finite, a conicity < 0 or not finite; HM_ENOCRIT without such a
+ * root; HM_ENONFINITE where the point does not move in it). */
+hm_status hm_mode_model_displacement_per_accel(hm_mode_model m, double conicity, double speed_kmh,
+                                               const hm_sensor_point *point, double f_hz, double *out);
+
 /* ---- the monitor's reading on the model ----
  * The monitor reads the hunting mode off the sensor's spectrum as one or two pole pairs over a smooth background
  * (modal.h), and on a bogie that reading is no eigenvalue: its two wheelsets meet the same track 2b / v apart and an

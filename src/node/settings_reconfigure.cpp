@@ -18,6 +18,8 @@ const Field kFields[] = {
      [](hm_monitor_config* c) { return &c->alarm.warn_amplitude_fraction; }},
     {"alarm.warn_speed_margin_kmh", &MonitorConfig::warn_speed_margin_kmh,
      [](hm_monitor_config* c) { return &c->alarm.warn_speed_margin_kmh; }},
+    {"alarm.warn_standard_errors", &MonitorConfig::warn_standard_errors,
+     [](hm_monitor_config* c) { return &c->alarm.warn_standard_errors; }},
     {"alarm.watch_speed_margin_kmh", &MonitorConfig::watch_speed_margin_kmh,
      [](hm_monitor_config* c) { return &c->alarm.watch_speed_margin_kmh; }},
     {"alarm.hysteresis_kmh", &MonitorConfig::hysteresis_kmh,

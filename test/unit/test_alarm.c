@@ -38,6 +38,13 @@ static hm_alarm make_prior(double lo, double hi) {
  * fallback makes the interval, as a vehicle whose conicity was measured. */
 static hm_alarm make(void) { return make_prior(0.1358 - 1e-5, 0.1358 + 1e-5); }
 
+/* The default WARN rule's standard errors (alarm.h: WARN from the point less max(margin, k standard errors)). */
+static double warn_k(void) {
+  hm_alarm_config c;
+  hm_alarm_config_default(&c);
+  return c.warn_standard_errors;
+}
+
 static double hopf_closed_form(double conicity) {
   double vc;
   hm_linear_critical_speed(&vehicle, conicity, &vc);
@@ -501,7 +508,7 @@ static void bad_configuration_and_input(void) {
 static void levels_with_a_conicity_estimate(void) {
   const hm_margin_estimate g = identified();
   const double h = g.hopf_model_kmh - g.hopf_model_low_kmh;
-  const double warn_from = g.hopf_model_kmh - fmax(10.0, h / 2.0), watch_from = g.hopf_model_kmh - sqrt(h * h + 900.0);
+  const double warn_from = g.hopf_model_kmh - fmax(10.0, warn_k() * h / 2.0), watch_from = g.hopf_model_kmh - sqrt(h * h + 900.0);
   const struct {
     double v, amp;
     hm_level level;
@@ -559,7 +566,8 @@ static void levels_with_a_conicity_estimate(void) {
   HM_CHECK_DELTA(s.hopf_low_kmh, hopf_closed_form(0.26), 1e-9, "uncertain estimate: low end");
   HM_CHECK_DELTA(s.hopf_high_kmh, hopf_closed_form(0.1358 - 0.03), 1e-9, "uncertain estimate: high end");
   const double from_e =
-      hopf_closed_form(0.16) - fmin(0.5 * (hopf_closed_form(0.16) - hopf_closed_form(0.26)), HM_ALARM_WARN_MAX_BELOW_KMH);
+      hopf_closed_form(0.16) - fmax(10.0, fmin(warn_k() * 0.5 * (hopf_closed_form(0.16) - hopf_closed_form(0.26)),
+                                               HM_ALARM_WARN_MAX_BELOW_KMH));
   HM_CHECK_DELTA(s.warn_from_kmh, fmin(hopf_closed_form(0.1658) - 10.0, from_e), 1e-9, "uncertain estimate: WARN from");
   HM_CHECK(s.level == HM_LEVEL_WATCH && s.reason == HM_REASON_APPROACHING_HOPF, "uncertain estimate at 400 km/h: %s",
            hm_level_name(s.level));
@@ -579,7 +587,7 @@ static void levels_with_a_conicity_estimate(void) {
   lower.hopf_free_low_kmh = g.hopf_model_low_kmh - 30.0;
   lower.hopf_free_high_kmh = g.hopf_model_high_kmh - 30.0;
   const double h_free = g.hopf_model_kmh - lower.hopf_free_low_kmh;
-  const double v_free = g.hopf_model_kmh - fmax(10.0, h_free / 2.0) + 0.5;
+  const double v_free = g.hopf_model_kmh - fmax(10.0, warn_k() * h_free / 2.0) + 0.5;
   e = estimate(v_free, 0.0);
   for (unsigned n = 2; n <= 4; ++n) {
     /* n 2: two windows; 3: three with a lightly damped mode held; 4: three without one (the zero extrapolated) */
@@ -1075,14 +1083,35 @@ static void what_the_model_may_not_explain(void) {
   /* the WARN rule's risk */
   HM_CHECK(hm_alarm_update(a, &e, &g, 171.0, &s) == HM_OK && s.conicity_from_estimate, "identified");
   const double se = (g.hopf_model_kmh - g.hopf_model_low_kmh) / 2.0;
-  HM_CHECK_DELTA(s.warn_risk, 0.5 * erfc(fmax(10.0, se) / se / sqrt(2.0)), 1e-12, "risk, 0.16 +- 0.003");
+  HM_CHECK_DELTA(s.warn_risk, 0.5 * erfc(fmax(10.0, warn_k() * se) / se / sqrt(2.0)), 1e-12, "risk, 0.16 +- 0.003");
   hm_margin_estimate wide = g;
   wide.conicity_se = 0.009, wide.conicity_low = 0.142, wide.conicity_high = 0.178;
   wide.hopf_model_low_kmh = hopf_closed_form(0.178), wide.hopf_model_high_kmh = hopf_closed_form(0.142);
   HM_CHECK(hm_alarm_update(a, &e, &wide, 172.0, &s) == HM_OK && s.conicity_from_estimate, "identified, wide");
-  HM_CHECK((g.hopf_model_kmh - wide.hopf_model_low_kmh) / 2.0 > 10.0, "one standard error above the margin");
-  HM_CHECK_DELTA(s.warn_risk, 0.1586552539, 1e-9, "risk at one standard error: Phi(-1)");
+  const double se_wide = (g.hopf_model_kmh - wide.hopf_model_low_kmh) / 2.0;
+  HM_CHECK(se_wide > 10.0, "one standard error above the margin");
+  HM_CHECK_DELTA(s.warn_risk, 0.5 * erfc(fmax(10.0, warn_k() * se_wide) / se_wide / sqrt(2.0)), 1e-12,
+                 "risk at the default k standard errors (k 1: Phi(-1) = 0.1587)");
   hm_alarm_destroy(a);
+  /* warn_standard_errors k: WARN from the point less max(10, k se); the risk Phi(-max(10, k se) / se); k = 0.5 on the
+   * wide estimate (se 13.2 km/h: 10 km/h below the point, the margin), k = 2 (26.4: the 20 km/h cap) */
+  const double se_w = (wide.hopf_model_kmh - wide.hopf_model_low_kmh) / 2.0;
+  const double ks[] = {0.5, 2.0};
+  for (size_t i = 0; i < 2; ++i) {
+    hm_alarm_config c;
+    hm_alarm_config_default(&c);
+    c.conicity_prior_low = 0.1358 - 1e-5, c.conicity_prior_high = 0.1358 + 1e-5;
+    c.warn_standard_errors = ks[i];
+    char why[160];
+    HM_CHECK(hm_alarm_create(&c, &vehicle, table, &a, why, sizeof why) == HM_OK, "create: %s", why);
+    HM_CHECK(hm_alarm_update(a, &e, &wide, 172.0, &s) == HM_OK && s.conicity_from_estimate, "k %g: identified", ks[i]);
+    const double below = fmax(10.0, fmin(ks[i] * se_w, 20.0));
+    HM_CHECK(fabs(s.warn_from_kmh - (wide.hopf_model_kmh - below)) < 1e-9, "k %g: WARN from %.3f", ks[i], s.warn_from_kmh);
+    HM_CHECK(fabs(s.warn_risk - 0.5 * erfc(below / se_w / sqrt(2.0))) < 1e-12, "k %g: risk %g", ks[i], s.warn_risk);
+    hm_alarm_destroy(a);
+  }
+  HM_CHECK(fabs(se_w - 13.2) < 0.5 && ks[0] * se_w < 10.0 && ks[1] * se_w > 20.0, "the cases as described: se %.2f",
+           se_w);
 }
 
 /* A restore keeps the estimate's hysteresis (state.h, hm_alarm_snapshot): restored while the estimate of 0.16 is in

@@ -223,6 +223,7 @@ static void monitor_settings(void) {
       {"estimator:\n  peaks_count: 6.5\n", "estimator.peaks_count: expected a whole number", HM_EPARSE},
       {"estimator:\n  sample_rate_hz: 20\n", "estimator.sample_rate_hz: must be in [100, 5000]", HM_EDOMAIN},
       {"alarm:\n  min_hold_s: -1\n", "alarm.min_hold_s: must be in [0, 3600] (got -1)", HM_EDOMAIN},
+      {"alarm:\n  warn_standard_errors: 6\n", "alarm.warn_standard_errors: must be in [0, 5] (got 6)", HM_EDOMAIN},
       {"modal:\n  window_s: 1000\n", "modal.window_s: must be in [5, 300]", HM_EDOMAIN},
       {"modal:\n  min_peak_prominence: -1\n", "modal.min_peak_prominence: must be 0 (off) or in [2, 100]", HM_EDOMAIN},
       {"modal:\n  min_peak_prominence: 1\n", "modal.min_peak_prominence: must be 0 (off) or in [2, 100]", HM_EDOMAIN},

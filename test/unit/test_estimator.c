@@ -188,6 +188,48 @@ static void displacement_criterion_at_any_frequency(void) {
   }
 }
 
+/* A displacement map (estimator.h): a frame's oscillation judged as the wheelsets' displacement it implies. A map of
+ * 4e-4 m per m/s^2 (the default bogie's frame near its Hopf speed, test_mode_model) on a 14 Hz oscillation of 6 m/s^2
+ * (the frame's own 0.78 mm): the wheelsets' 2.4 mm, met against 2.1 mm; at 4 m/s^2 (1.6 mm) not; a map that cannot
+ * tell (0) leaves the sensor's own displacement and no judgement; the map is asked at the tracked frequency and the
+ * speed. */
+static double map_calls_f, map_calls_v;
+static double frame_map(void *ctx, double f_hz, double speed_kmh) {
+  map_calls_f = f_hz, map_calls_v = speed_kmh;
+  return *(const double *)ctx;
+}
+
+static void displacement_map(void) {
+  const struct {
+    double a, map;
+    int exceeded;
+  } cases[] = {{6.0, 4e-4, 1}, {4.0, 4e-4, 0}, {6.0, 0.0, 0}};
+  for (int i = 0; i < 3; ++i) {
+    hm_estimator_config c;
+    hm_estimator_config_default(&c);
+    hm_estimator_config_criteria(&c, HM_POINT_BOGIE_FRAME);
+    c.displacement_limit_m = 2.1e-3;
+    hm_estimator e = NULL;
+    HM_CHECK(hm_estimator_create(&c, &e, NULL, 0) == HM_OK, "create");
+    hm_estimator_set_displacement_map(e, frame_map, (void *)&cases[i].map);
+    const double w = 2.0 * HM_PI * 14.0;
+    hm_estimate est;
+    for (long k = 0; k < 2000L * 4; ++k) {
+      const double t = k / 2000.0;
+      if (k % 20 == 0) hm_estimator_push_speed(e, t, 480.0);
+      hm_estimator_push_accel(e, t, cases[i].a * sin(w * t));
+    }
+    hm_estimator_read(e, 4.0, &est);
+    const double want = cases[i].map > 0.0 ? cases[i].a * cases[i].map : cases[i].a / (w * w);
+    HM_CHECK(fabs(est.amplitude_displacement_m / want - 1.0) < 0.02, "case %d: displacement amplitude %g for %g", i,
+             est.amplitude_displacement_m, want);
+    HM_CHECK(est.displacement_exceeded == cases[i].exceeded, "case %d: criterion %d", i, est.displacement_exceeded);
+    HM_CHECK(fabs(map_calls_f - 14.0) < 0.05 && map_calls_v == 480.0, "asked at %g Hz, %g km/h", map_calls_f,
+             map_calls_v);
+    hm_estimator_destroy(e);
+  }
+}
+
 /* The wheelset limits are what estimator.h derives them from: an oscillation of half the 4.2 mm unstable cycle at
  * the default vehicle's lower fold (MODEL.md section 7) at the Hopf frequency w^2 = A3/A1 (closed form, linear.h):
  * r.m.s. 2.1 mm w^2 / sqrt(2) and peak 2.1 mm w^2, each within the 1% of their rounding; the bogie-frame limits are
@@ -435,6 +477,7 @@ int main(int argc, char **argv) {
   HM_RUN(criteria_against_closed_forms);
   HM_RUN(wheelset_limits_from_the_model);
   HM_RUN(displacement_criterion_at_any_frequency);
+  HM_RUN(displacement_map);
   HM_RUN(sample_rate_from_stamps);
   HM_RUN(lost_samples_counted_not_a_rate);
   HM_RUN(short_gaps_are_bridged);

@@ -613,10 +613,65 @@ static void damped_steps_come_back(void) {
   hm_modal_destroy(modal);
 }
 
+/* hm_mode_model_displacement_per_accel: at the wheelset's axle box (the point is its own lateral velocity) the
+ * closed form 1 / |lambda|^2 of its hunting root (inversion.h); at the default bogie's frame, 0.05 km/h below its
+ * Hopf speed, the forced response's ratio at the root's frequency (the track driving the mode, whose 1 / sigma
+ * resonance dwarfs the others there: a second method, hm_mode_model_sensor_spectrum and hm_mode_model_motion_rms's
+ * transfer); a frequency 10% off the least-damped root's: no ratio (HM_ENOCRIT), the output untouched. */
+static void displacement_per_accel(void) {
+  hm_vehicle veh;
+  hm_vehicle_default(&veh);
+  hm_mode_model w = NULL, m = NULL;
+  hm_bogie b;
+  hm_bogie_default(&b);
+  HM_CHECK(hm_mode_model_create_wheelset(&veh, &w) == HM_OK && hm_mode_model_create_bogie(&b, &m) == HM_OK, "create");
+  if (!w || !m) return;
+  hm_linear_coef coef;
+  hm_linear_coef_from_vehicle(&veh, &coef);
+  hm_sensor_point axle, frame;
+  HM_CHECK(hm_mode_model_sensor(w, "axlebox", &axle) == HM_OK && hm_mode_model_sensor(m, "frame", &frame) == HM_OK,
+           "sensors");
+  double s = 0.0, om = 0.0, r = 0.0;
+  HM_CHECK(hm_hunting_root(&coef, 430.0, 0.16, &s, &om) == HM_OK, "root");
+  HM_CHECK(hm_mode_model_displacement_per_accel(w, 0.16, 430.0, &axle, om / (2.0 * HM_PI) * 1.02, &r) == HM_OK,
+           "wheelset");
+  HM_CHECK_REL(r, 1.0 / (s * s + om * om), 1e-9, "wheelset: 1 / |lambda|^2");
+  double v = 0.0, f = 0.0;
+  HM_CHECK(hm_mode_model_hopf(m, 0.1358, &v, &f, NULL) == HM_OK, "bogie Hopf");
+  const double vb = v - 0.05;
+  double sb = 0.0, omb = 0.0;
+  HM_CHECK(hm_mode_model_least_damped(m, 0.1358, vb, &sb, &omb) == HM_OK && sb < 0.0 && sb > -0.05, "near Hopf");
+  const double fb = omb / (2.0 * HM_PI);
+  HM_CHECK(hm_mode_model_displacement_per_accel(m, 0.1358, vb, &frame, fb, &r) == HM_OK, "frame");
+  /* the forced response at fb: |A|^2 S from the sensor's spectrum, |R_i|^2 S from the motion's integrand (one bin) */
+  double acc2 = 0.0;
+  HM_CHECK(hm_mode_model_sensor_spectrum(m, 0.1358, vb, &frame, &fb, 1, &acc2) == HM_OK, "frame spectrum");
+  /* each axle box (bogie.h: the wheelsets' lateral velocities are states 1 and 5): its acceleration over (2 pi f)^2
+   * is the wheelset's displacement */
+  const hm_sensor_point wheel[2] = {{1, {1, 0, 0, 0}, {1.0, 0.0, 0.0, 0.0}}, {1, {5, 0, 0, 0}, {1.0, 0.0, 0.0, 0.0}}};
+  double ax2[2] = {0.0, 0.0};
+  for (int i = 0; i < 2; ++i)
+    HM_CHECK(hm_mode_model_sensor_spectrum(m, 0.1358, vb, &wheel[i], &fb, 1, &ax2[i]) == HM_OK, "axle-box spectrum");
+  const double forced = sqrt(fmax(ax2[0], ax2[1]) / acc2) / pow(2.0 * HM_PI * fb, 2.0);
+  printf("  frame at %.2f km/h, %.3f Hz: %.4g m per m/s^2 from the mode shape, %.4g from the forced response\n", vb, fb,
+         r, forced);
+  HM_CHECK_REL(r, forced, 0.02, "frame: the mode shape against the forced response at resonance");
+  HM_CHECK(r * pow(2.0 * HM_PI * fb, 2.0) > 2.0, "the frame moves less than half as much as the wheelsets in it");
+  double untouched = -1.0;
+  HM_CHECK(hm_mode_model_displacement_per_accel(m, 0.1358, vb, &frame, fb * 1.1, &untouched) == HM_ENOCRIT &&
+               untouched == -1.0, "10%% off the root's frequency: none");
+  HM_CHECK(hm_mode_model_displacement_per_accel(m, 0.1358, -1.0, &frame, fb, &untouched) == HM_EDOMAIN &&
+               hm_mode_model_displacement_per_accel(m, 0.1358, vb, &frame, NAN, &untouched) == HM_EDOMAIN &&
+               untouched == -1.0, "bad speed or frequency");
+  hm_mode_model_destroy(w);
+  hm_mode_model_destroy(m);
+}
+
 int main(void) {
   HM_RUN(wheelset_as_inversion_h);
   HM_RUN(bogie_and_car_find_their_own_conicity);
   HM_RUN(hopf_curve);
+  HM_RUN(displacement_per_accel);
   HM_RUN(band_kink_and_low_speeds);
   HM_RUN(reading_of_the_wheelset_is_its_root);
   HM_RUN(reading_inverts_back);

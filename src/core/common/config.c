@@ -522,6 +522,7 @@ static const settings_field margin_fields[] = {
 
 static const settings_field alarm_fields[] = {
     ALM(warn_amplitude_fraction, FIELD_DOUBLE), ALM(warn_speed_margin_kmh, FIELD_DOUBLE),
+    ALM(warn_standard_errors, FIELD_DOUBLE),
     ALM(watch_speed_margin_kmh, FIELD_DOUBLE),  ALM(hysteresis_kmh, FIELD_DOUBLE),
     ALM(hysteresis_amplitude_fraction, FIELD_DOUBLE),
     ALM(min_hold_s, FIELD_DOUBLE),              ALM(use_conicity_estimate, FIELD_BOOL),

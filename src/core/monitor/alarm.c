@@ -144,6 +144,7 @@ size_t hm_assessment_reason_text(const hm_assessment *s, double origin_s, char *
 void hm_alarm_config_default(hm_alarm_config *c) {
   c->warn_amplitude_fraction = 0.5;
   c->warn_speed_margin_kmh = 10.0;
+  c->warn_standard_errors = 1.0;
   c->watch_speed_margin_kmh = 30.0;
   c->hysteresis_kmh = 3.0;
   c->hysteresis_amplitude_fraction = 0.1;
@@ -163,6 +164,7 @@ hm_status hm_alarm_config_validate(const hm_alarm_config *c, char *why, size_t l
   const hm_field_check f[] = {
       {"warn_amplitude_fraction", c->warn_amplitude_fraction, HM_RULE_OPEN, 0.0, 1.0},
       {"warn_speed_margin_kmh", c->warn_speed_margin_kmh, HM_RULE_RANGE, 0.0, 500.0},
+      {"warn_standard_errors", c->warn_standard_errors, HM_RULE_RANGE, 0.0, 5.0},
       {"watch_speed_margin_kmh", c->watch_speed_margin_kmh, HM_RULE_RANGE, 0.0, 500.0},
       {"hysteresis_kmh", c->hysteresis_kmh, HM_RULE_RANGE, 0.0, 100.0},
       {"hysteresis_amplitude_fraction", c->hysteresis_amplitude_fraction, HM_RULE_RANGE, 0.0, 1.0},
@@ -467,8 +469,8 @@ static double sustained_acceleration(hm_alarm a, double now, double v_kmh) {
 
 /* WARN from an identified Hopf speed (alarm.h): the point less the larger of the margin and one standard error, the
  * lower half-width (point - low) being z of them. */
-static double warn_below_point(double point_kmh, double low_kmh, double margin_kmh, double z) {
-  return point_kmh - fmax(margin_kmh, fmin((point_kmh - low_kmh) / z, HM_ALARM_WARN_MAX_BELOW_KMH));
+static double warn_below_point(double point_kmh, double low_kmh, double margin_kmh, double z, double k) {
+  return point_kmh - fmax(margin_kmh, fmin(k * (point_kmh - low_kmh) / z, HM_ALARM_WARN_MAX_BELOW_KMH));
 }
 
 /* The speed margins (alarm.h): added to a range's lower end; below an identified interval WATCH in quadrature with
@@ -483,11 +485,13 @@ static void speed_thresholds(const hm_alarm a, const hm_margin_estimate *g, cons
   const double h = ev->precise ? b->hopf_speed_kmh - s->hopf_low_kmh : 0.0;
   const double from = ev->precise ? b->hopf_speed_kmh : s->hopf_low_kmh;
   const double z = g && g->interval_z > 0.0 ? g->interval_z : 1.0;
-  s->warn_from_kmh = warn_below_point(from, ev->precise ? s->hopf_low_kmh : from, c->warn_speed_margin_kmh, z);
+  s->warn_from_kmh =
+      warn_below_point(from, ev->precise ? s->hopf_low_kmh : from, c->warn_speed_margin_kmh, z, c->warn_standard_errors);
   if (ev->usable && !ev->precise) {
     const double lo_e = ev->free_counts ? fmin(g->hopf_model_low_kmh, a->ev.free_low_kmh) : g->hopf_model_low_kmh;
     s->warn_from_kmh = fmin(a->prior_hopf_low_kmh - c->warn_speed_margin_kmh,
-                            warn_below_point(g->hopf_model_kmh, lo_e, c->warn_speed_margin_kmh, z));
+                            warn_below_point(g->hopf_model_kmh, lo_e, c->warn_speed_margin_kmh, z,
+                                             c->warn_standard_errors));
   }
   s->watch_from_kmh = from - hypot(h, c->watch_speed_margin_kmh);
   s->warn_risk = ev->precise && h > 0.0 ? 0.5 * erfc((from - s->warn_from_kmh) / (h / z) / sqrt(2.0)) : NAN;

@@ -17,6 +17,8 @@ enum { BAND_SECTIONS = 4 };
 
 struct hm_estimator_s {
   hm_estimator_config cfg;
+  hm_displacement_map_fn disp_map; /* the wheelset's displacement per acceleration (NULL: the sensor's own) */
+  void *disp_ctx;
   hm_biquad band[BAND_SECTIONS];    /* HP4 + LP4 */
   hm_criteria criteria;           /* the standard criteria on the same samples */
   /* sample history */
@@ -257,6 +259,12 @@ hm_status hm_estimator_set_limits(hm_estimator e, const hm_estimator_config *cfg
   return HM_OK;
 }
 
+void hm_estimator_set_displacement_map(hm_estimator e, hm_displacement_map_fn fn, void *ctx) {
+  if (!e) return;
+  e->disp_map = fn;
+  e->disp_ctx = fn ? ctx : NULL;
+}
+
 unsigned long hm_estimator_restarts(const hm_estimator e, double *design_rate_hz) {
   if (!e) return 0;
   if (design_rate_hz) *design_rate_hz = e->design_rate_hz;
@@ -463,6 +471,12 @@ void hm_estimator_read(const hm_estimator e, double now, hm_estimate *out) {
   r.period_spread = r.oscillation_valid ? spread : 1.0;
   const double w = 2.0 * HM_PI * r.frequency_hz;
   r.amplitude_displacement_m = r.oscillation_valid ? r.amplitude_accel_mps2 / (w * w) : 0.0;
+  int judged = 1; /* (c) judges the displacement: the sensor's own, or the wheelset's where the map tells it */
+  if (e->disp_map && r.oscillation_valid) {
+    const double s = r.speed_valid ? e->disp_map(e->disp_ctx, r.frequency_hz, r.speed_kmh) : 0.0;
+    judged = s > 0.0 && isfinite(s);
+    if (judged) r.amplitude_displacement_m = r.amplitude_accel_mps2 * s;
+  }
   hm_criteria_state k;
   hm_criteria_read(e->criteria, &k);
   r.rms_mps2 = k.rms_mps2;
@@ -470,7 +484,7 @@ void hm_estimator_read(const hm_estimator e, double now, hm_estimate *out) {
   r.rms_exceeded = k.rms_exceeded;
   r.consecutive_peaks = k.consecutive_peaks;
   r.peaks_exceeded = k.peaks_exceeded;
-  r.displacement_exceeded = c->displacement_limit_m > 0.0 && r.oscillation_valid && r.period_spread <= 0.2 &&
+  r.displacement_exceeded = judged && c->displacement_limit_m > 0.0 && r.oscillation_valid && r.period_spread <= 0.2 &&
                             r.amplitude_displacement_m >= c->displacement_limit_m;
   *out = r;
 }

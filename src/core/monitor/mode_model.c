@@ -595,6 +595,41 @@ hm_status hm_mode_model_motion_rms(hm_mode_model m, double conicity, double spee
   return HM_OK;
 }
 
+hm_status hm_mode_model_displacement_per_accel(hm_mode_model m, double conicity, double speed_kmh,
+                                               const hm_sensor_point *point, double f_hz, double *out) {
+  if (!m || !point || !out) return HM_EINVAL;
+  if (!(speed_kmh > 0.0) || !isfinite(speed_kmh) || !(f_hz > 0.0) || !isfinite(f_hz) || !(conicity >= 0.0) ||
+      !isfinite(conicity))
+    return HM_EDOMAIN;
+  hm_status st = set_conicity(m, conicity);
+  if (st != HM_OK) return st;
+  const hm_system *sys = &m->sys;
+  if (!hm_sensor_point_valid(sys, point)) return HM_EINVAL;
+  const size_t d = sys->dim;
+  double re[NMAX], im[NMAX], vr[NMAX * NMAX];
+  if ((st = hm_system_eig(sys, hm_mps_from_kmh(speed_kmh), re, im, vr)) != HM_OK) return st;
+  int k = -1; /* the least-damped oscillatory root, if f lies within HM_MODE_MODEL_SHAPE_BAND of its frequency */
+  for (size_t j = 0; j < d; ++j)
+    if (im[j] > 0.0 && (k < 0 || re[j] > re[k])) k = (int)j;
+  if (k < 0 || !(fabs(im[k] / (2.0 * HM_PI) / f_hz - 1.0) <= HM_MODE_MODEL_SHAPE_BAND))
+    return HM_ENOCRIT; /* (not that mode's oscillation) */
+  const double _Complex lam = re[k] + I * im[k];
+  double _Complex acc = 0.0; /* dgeev's pair: columns k (real part) and k + 1 (imaginary part) */
+  for (size_t j = 0; j < point->n_terms; ++j) {
+    const size_t s = (size_t)point->state[j];
+    acc += point->weight[j] * lam * (vr[s + d * (size_t)k] + I * vr[s + d * (size_t)(k + 1)]);
+  }
+  double most = 0.0;
+  for (size_t i = 0; i < sys->n_wheelsets; ++i) {
+    const size_t s = (size_t)sys->wheelset_y_state[i];
+    most = fmax(most, cabs(vr[s + d * (size_t)k] + I * vr[s + d * (size_t)(k + 1)]));
+  }
+  const double r = most / cabs(acc);
+  if (!(r > 0.0) || !isfinite(r)) return HM_ENONFINITE;
+  *out = r;
+  return HM_OK;
+}
+
 /* Gaussian equivalent linearisation (Roberts and Spanos, Random Vibration and Statistical Linearization, ch. 5): a
  * wheelset moving about the track as a Gaussian process of rms s sees the wheel-rail terms' mean derivative E[d f /
  * d r] over r ~ N(0, s^2), not the derivative at rest (the flange force F_T(r) = alpha1 r^3 + alpha2 r^5 of MODEL.md

@@ -146,6 +146,8 @@ hm_status hm_monitor_create_parallel(const hm_monitor_config *cfg, const hm_vehi
   return hm_monitor_create_model(cfg, HM_MODEL_WHEELSET, &params, table, pfor, runner, out, why, len);
 }
 
+static double wheelset_displacement(void *ctx, double f_hz, double speed_kmh);
+
 hm_status hm_monitor_create_model(const hm_monitor_config *cfg, hm_model_kind kind, const hm_car *params,
                                   hm_table table, hm_parallel_for_fn pfor, void *runner, hm_monitor *out, char *why,
                                   size_t len) {
@@ -186,12 +188,15 @@ hm_status hm_monitor_create_model(const hm_monitor_config *cfg, hm_model_kind ki
     if (st == HM_OK) st = hm_mode_model_set_sensor(model, where);
     hm_mode_model_set_reading_gain(model, hm_modal_filter_power_gain, m->modal);
     m->spec_at = NAN; /* (no spectrum fitted yet) */
+    if (st == HM_OK) st = hm_mode_model_sensor(model, where, &m->sensor);
     if (st == HM_OK && cfg->margin.spectrum_high_hz > 0.0) { /* the spectrum's fit (margin.h) */
       m->spec_f = malloc(HM_SPECTRUM_FIT_MAX_BINS * sizeof(double));
       m->spec_p = malloc(HM_SPECTRUM_FIT_MAX_BINS * sizeof(double));
       st = m->spec_f && m->spec_p ? HM_OK : HM_ENOMEM;
-      if (st == HM_OK) st = hm_mode_model_sensor(model, where, &m->sensor);
     }
+    /* a frame sensor's oscillation judged as the wheelsets' displacement it implies (estimator.h) */
+    if (st == HM_OK && cfg->estimator.measurement_point == HM_POINT_BOGIE_FRAME)
+      hm_estimator_set_displacement_map(m->est, wheelset_displacement, m);
     hm_margin_set_model(m->margin, model);
     if (st == HM_OK) st = hm_alarm_set_model(m->alarm, model);
   }
@@ -307,6 +312,17 @@ static void track_lines_of(hm_monitor m, double t, double v, hm_mode_estimate *m
     hm_track_lines_observe(&m->lines, t, v, mode->lone_line_hz[k], mode->lone_line_mps2[k], 0);
   if (mode->lines_found)
     hm_track_lines_observe(&m->lines, t, v, mode->line_fundamental_hz, 0.0, 1);
+}
+
+/* The estimator's displacement map (estimator.h) on the model: the wheelsets' displacement per acceleration at the
+ * sensor at the conicity in use (none before the first assessment). */
+static double wheelset_displacement(void *ctx, double f_hz, double speed_kmh) {
+  const hm_monitor m = ctx;
+  double s = 0.0;
+  if (isfinite(m->conicity_in_use) &&
+      hm_mode_model_displacement_per_accel(m->model, m->conicity_in_use, speed_kmh, &m->sensor, f_hz, &s) != HM_OK)
+    s = 0.0;
+  return s;
 }
 
 /* The window's conicity from the model's whole spectrum at the sensor (spectrum_fit.h, linearised about the motion it
