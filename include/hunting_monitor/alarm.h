@@ -46,7 +46,7 @@
  *            measurement point; the displacement amplitude at any frequency of the band, estimator.h), the speed above the Hopf interval (the origin is unstable), or the displacement
  *            amplitude at or beyond the edge. Reduce speed now, below the lower end of the Hopf interval.
  *   WARN     close to the boundary: the speed at or above warn_from_kmh (warn_speed_margin_kmh below the Hopf speed,
- *            or one standard error of it where larger: see below), or the amplitude above warn_amplitude_fraction of
+ *            or warn_standard_errors of it where larger: see below), or the amplitude above warn_amplitude_fraction of
  *            the edge.
  *            Do not accelerate; reduce speed by the margin.
  *   WATCH    the speed at or above watch_from_kmh (the same with watch_speed_margin_kmh), or the vehicle not behaving like its
@@ -202,9 +202,10 @@ typedef struct {
 #define HM_ALARM_STEP_RATE_KMH_S 5.0
 #define HM_ALARM_STEP_NOISE_KMH 3.0
 #define HM_ALARM_ACCEL_SILENCE_S 10.0
-/* WARN below an identified point by one standard error, but not by more than this [km/h] (or the margin, if larger):
- * from windows far below the Hopf speed one standard error reached 28 km/h and WARN came 23 km/h below the truth;
- * WATCH keeps the whole half-width. The risk, Phi(-min(se, 20) / se), is in the status (warn_risk). */
+/* WARN below an identified point by warn_standard_errors (k) standard errors, but not by more than this [km/h] (or the
+ * margin, if larger): from windows far below the Hopf speed one standard error reached 28 km/h and WARN came 23 km/h
+ * below the truth; WATCH keeps the whole half-width. The risk, Phi(-max(margin, min(k se, 20)) / se), is in the
+ * status (warn_risk). */
 #define HM_ALARM_WARN_MAX_BELOW_KMH 20.0
 /* A standard error once within conicity_max_se stays within it up to this times conicity_max_se. */
 #define HM_ALARM_SE_HYSTERESIS 1.25

@@ -123,7 +123,9 @@ typedef struct {
   int oscillation_valid;          /* tracker settled: a full tracking time of samples and a frequency */
   double amplitude_accel_mps2;
   double frequency_hz;            /* 0 if not valid */
-  double amplitude_displacement_m;/* 0 if the frequency is not valid; with a displacement map (below) the wheelset's */
+  double amplitude_displacement_m;/* the sensor's own, a / (2 pi f)^2; 0 if the frequency is not valid */
+  double wheelset_displacement_m; /* with a displacement map (below): the wheelsets' it implies, which (c) judges; 0
+                                     where it cannot tell or without a map */
   double period_spread;           /* relative standard deviation of the recent periods */
   double rms_mps2;                /* sliding r.m.s. over the window (or what is available of it) */
   int rms_window_complete;
@@ -154,11 +156,14 @@ hm_status hm_estimator_set_limits(hm_estimator est, const hm_estimator_config *c
  * and speed, or a value <= 0 or not finite where it cannot be told; a vehicle model's (mode_model.h,
  * hm_mode_model_displacement_per_accel) for a sensor away from the axle box. */
 typedef double (*hm_displacement_map_fn)(void *ctx, double f_hz, double speed_kmh);
-/* With a map (fn not NULL) amplitude_displacement_m is the wheelset's, amp x fn(ctx, f, speed), and the displacement
- * criterion (c) judges it (a bogie frame sees about a tenth of its wheelsets' motion at their hunting frequency, and
- * the standards' frame limits came 3-50 s after 3 mm on a bogie that is not its description, docs/VEHICLES.md);
- * where the map cannot tell (no valid speed, a value <= 0) the displacement is the sensor's own and (c) does not
- * judge. NULL: the sensor's own, a / (2 pi f)^2. */
+/* With a map (fn not NULL) wheelset_displacement_m is the wheelsets', amp x fn(ctx, f, speed), and the displacement
+ * criterion (c), with its coherence (period spread at most 0.2), judges it instead of the sensor's own (a bogie frame
+ * moves a third to a thirtieth as much as its wheelsets in their hunting mode, and the standards' frame limits came
+ * 3-50 s after 3 mm on a bogie that is not its description, docs/VEHICLES.md); where the map cannot tell (no valid
+ * speed, a value <= 0) (c) does not judge. amplitude_displacement_m, which the alarm's amplitude rules read, stays the
+ * sensor's own: a frame's ambient motion near the hunting frequency is not the mode's, and read through the mode's
+ * shape it overstates the wheelsets' (2.6-4.8 mm for 1.1-2.0 mm, a review's); only a coherent oscillation is
+ * taken for the mode. NULL: no map. */
 void hm_estimator_set_displacement_map(hm_estimator est, hm_displacement_map_fn fn, void *ctx);
 /* How many times the filters restarted (gaps, redesigns for a measured rate, resets), and the rate they are designed
  * for now: a consumer of the same stream (the modal identification) restarts with them. */

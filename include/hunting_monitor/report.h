@@ -68,7 +68,7 @@ enum { HM_REPORT_TEXT_LEN = 512 };
   X(margin_lowest_cycle_kmh, NUMBER) X(cycles_valid, FLAG) X(unstable_cycle_amplitude_m, NUMBER)                       \
   X(stable_cycle_amplitude_m, NUMBER)                                                                                  \
   X(rms_mps2, NUMBER) X(rms_exceeded, FLAG) X(consecutive_peaks, INT) X(peaks_exceeded, FLAG)                          \
-  X(displacement_exceeded, FLAG)                                                                                       \
+  X(displacement_exceeded, FLAG) X(wheelset_displacement_m, NUMBER)                                                    \
   X(accel_samples, INT) X(rejected_samples, INT) X(rejected_nonfinite, INT) X(rejected_out_of_range, INT)              \
   X(rejected_out_of_order, INT) X(gaps, INT) X(samples_lost, INT) X(samples_lost_fraction, NUMBER)                     \
   X(rate_changes, INT) X(speed_updates, INT) X(rejected_speeds, INT)

@@ -546,6 +546,7 @@ void MonitorRos::fillBoundaries(const hm_report& r, const hm_monitor_status& st,
   m.criterion_rms_exceeded = r.rms_exceeded;
   m.criterion_peaks_exceeded = r.peaks_exceeded;
   m.criterion_displacement_exceeded = r.displacement_exceeded;
+  m.wheelset_displacement_m = finite(r.wheelset_displacement_m);
 }
 
 void MonitorRos::publishLevel(const hm_assessment& s, const std::string& text, const ros::Time& now) {

@@ -191,8 +191,8 @@ static void displacement_criterion_at_any_frequency(void) {
 /* A displacement map (estimator.h): a frame's oscillation judged as the wheelsets' displacement it implies. A map of
  * 4e-4 m per m/s^2 (the default bogie's frame near its Hopf speed, test_mode_model) on a 14 Hz oscillation of 6 m/s^2
  * (the frame's own 0.78 mm): the wheelsets' 2.4 mm, met against 2.1 mm; at 4 m/s^2 (1.6 mm) not; a map that cannot
- * tell (0) leaves the sensor's own displacement and no judgement; the map is asked at the tracked frequency and the
- * speed. */
+ * tell (0): no judgement, even at 20 m/s^2 (the frame's own 2.6 mm, beyond the limit); the sensor's own
+ * displacement is reported beside it either way; the map is asked at the tracked frequency and the speed. */
 static double map_calls_f, map_calls_v;
 static double frame_map(void *ctx, double f_hz, double speed_kmh) {
   map_calls_f = f_hz, map_calls_v = speed_kmh;
@@ -203,8 +203,8 @@ static void displacement_map(void) {
   const struct {
     double a, map;
     int exceeded;
-  } cases[] = {{6.0, 4e-4, 1}, {4.0, 4e-4, 0}, {6.0, 0.0, 0}};
-  for (int i = 0; i < 3; ++i) {
+  } cases[] = {{6.0, 4e-4, 1}, {4.0, 4e-4, 0}, {6.0, 0.0, 0}, {20.0, 0.0, 0}};
+  for (int i = 0; i < 4; ++i) {
     hm_estimator_config c;
     hm_estimator_config_default(&c);
     hm_estimator_config_criteria(&c, HM_POINT_BOGIE_FRAME);
@@ -220,9 +220,11 @@ static void displacement_map(void) {
       hm_estimator_push_accel(e, t, cases[i].a * sin(w * t));
     }
     hm_estimator_read(e, 4.0, &est);
-    const double want = cases[i].map > 0.0 ? cases[i].a * cases[i].map : cases[i].a / (w * w);
-    HM_CHECK(fabs(est.amplitude_displacement_m / want - 1.0) < 0.02, "case %d: displacement amplitude %g for %g", i,
-             est.amplitude_displacement_m, want);
+    const double own = cases[i].a / (w * w), wheel = cases[i].a * cases[i].map;
+    HM_CHECK(fabs(est.amplitude_displacement_m / own - 1.0) < 0.02, "case %d: the sensor's own %g for %g", i,
+             est.amplitude_displacement_m, own);
+    HM_CHECK(wheel > 0.0 ? fabs(est.wheelset_displacement_m / wheel - 1.0) < 0.02 : est.wheelset_displacement_m == 0.0,
+             "case %d: the wheelsets' %g for %g", i, est.wheelset_displacement_m, wheel);
     HM_CHECK(est.displacement_exceeded == cases[i].exceeded, "case %d: criterion %d", i, est.displacement_exceeded);
     HM_CHECK(fabs(map_calls_f - 14.0) < 0.05 && map_calls_v == 480.0, "asked at %g Hz, %g km/h", map_calls_f,
              map_calls_v);

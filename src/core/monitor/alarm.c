@@ -467,7 +467,7 @@ static double sustained_acceleration(hm_alarm a, double now, double v_kmh) {
   return fmin(fmax(blocks_slope(a), 0.0), HM_ALARM_MAX_ACCEL_KMH_S);
 }
 
-/* WARN from an identified Hopf speed (alarm.h): the point less the larger of the margin and one standard error, the
+/* WARN from an identified Hopf speed (alarm.h): the point less the larger of the margin and k standard errors, the
  * lower half-width (point - low) being z of them. */
 static double warn_below_point(double point_kmh, double low_kmh, double margin_kmh, double z, double k) {
   return point_kmh - fmax(margin_kmh, fmin(k * (point_kmh - low_kmh) / z, HM_ALARM_WARN_MAX_BELOW_KMH));

@@ -471,11 +471,12 @@ void hm_estimator_read(const hm_estimator e, double now, hm_estimate *out) {
   r.period_spread = r.oscillation_valid ? spread : 1.0;
   const double w = 2.0 * HM_PI * r.frequency_hz;
   r.amplitude_displacement_m = r.oscillation_valid ? r.amplitude_accel_mps2 / (w * w) : 0.0;
-  int judged = 1; /* (c) judges the displacement: the sensor's own, or the wheelset's where the map tells it */
-  if (e->disp_map && r.oscillation_valid) {
-    const double s = r.speed_valid ? e->disp_map(e->disp_ctx, r.frequency_hz, r.speed_kmh) : 0.0;
-    judged = s > 0.0 && isfinite(s);
-    if (judged) r.amplitude_displacement_m = r.amplitude_accel_mps2 * s;
+  double judged_m = r.amplitude_displacement_m; /* what (c) judges: the sensor's own, or the wheelsets' by the map */
+  r.wheelset_displacement_m = 0.0;
+  if (e->disp_map) {
+    const double s = r.oscillation_valid && r.speed_valid ? e->disp_map(e->disp_ctx, r.frequency_hz, r.speed_kmh) : 0.0;
+    r.wheelset_displacement_m = s > 0.0 && isfinite(s) ? r.amplitude_accel_mps2 * s : 0.0;
+    judged_m = r.wheelset_displacement_m;
   }
   hm_criteria_state k;
   hm_criteria_read(e->criteria, &k);
@@ -484,7 +485,7 @@ void hm_estimator_read(const hm_estimator e, double now, hm_estimate *out) {
   r.rms_exceeded = k.rms_exceeded;
   r.consecutive_peaks = k.consecutive_peaks;
   r.peaks_exceeded = k.peaks_exceeded;
-  r.displacement_exceeded = judged && c->displacement_limit_m > 0.0 && r.oscillation_valid && r.period_spread <= 0.2 &&
-                            r.amplitude_displacement_m >= c->displacement_limit_m;
+  r.displacement_exceeded = c->displacement_limit_m > 0.0 && r.oscillation_valid && r.period_spread <= 0.2 &&
+                            judged_m > 0.0 && judged_m >= c->displacement_limit_m;
   *out = r;
 }

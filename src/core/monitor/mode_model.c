@@ -608,11 +608,11 @@ hm_status hm_mode_model_displacement_per_accel(hm_mode_model m, double conicity,
   const size_t d = sys->dim;
   double re[NMAX], im[NMAX], vr[NMAX * NMAX];
   if ((st = hm_system_eig(sys, hm_mps_from_kmh(speed_kmh), re, im, vr)) != HM_OK) return st;
-  int k = -1; /* the least-damped oscillatory root, if f lies within HM_MODE_MODEL_SHAPE_BAND of its frequency */
+  int k = -1; /* the least-damped oscillatory root within HM_MODE_MODEL_SHAPE_BAND of f */
   for (size_t j = 0; j < d; ++j)
-    if (im[j] > 0.0 && (k < 0 || re[j] > re[k])) k = (int)j;
-  if (k < 0 || !(fabs(im[k] / (2.0 * HM_PI) / f_hz - 1.0) <= HM_MODE_MODEL_SHAPE_BAND))
-    return HM_ENOCRIT; /* (not that mode's oscillation) */
+    if (im[j] > 0.0 && fabs(im[j] / (2.0 * HM_PI) / f_hz - 1.0) <= HM_MODE_MODEL_SHAPE_BAND && (k < 0 || re[j] > re[k]))
+      k = (int)j;
+  if (k < 0) return HM_ENOCRIT; /* (no mode there) */
   const double _Complex lam = re[k] + I * im[k];
   double _Complex acc = 0.0; /* dgeev's pair: columns k (real part) and k + 1 (imaginary part) */
   for (size_t j = 0; j < point->n_terms; ++j) {

@@ -44,6 +44,7 @@ static void estimate_part(const hm_estimate *e, hm_report *r) {
   r->consecutive_peaks = (long)e->consecutive_peaks;
   r->peaks_exceeded = e->peaks_exceeded;
   r->displacement_exceeded = e->displacement_exceeded;
+  r->wheelset_displacement_m = e->wheelset_displacement_m;
   r->accel_samples = (long)e->n_samples;
   r->rejected_samples = (long)(e->n_rejected_nonfinite + e->n_rejected_range + e->n_rejected_order);
   r->rejected_nonfinite = (long)e->n_rejected_nonfinite;
