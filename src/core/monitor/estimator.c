@@ -486,6 +486,6 @@ void hm_estimator_read(const hm_estimator e, double now, hm_estimate *out) {
   r.consecutive_peaks = k.consecutive_peaks;
   r.peaks_exceeded = k.peaks_exceeded;
   r.displacement_exceeded = c->displacement_limit_m > 0.0 && r.oscillation_valid && r.period_spread <= 0.2 &&
-                            judged_m > 0.0 && judged_m >= c->displacement_limit_m;
+                            judged_m >= c->displacement_limit_m;
   *out = r;
 }

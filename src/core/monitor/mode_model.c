@@ -595,6 +595,11 @@ hm_status hm_mode_model_motion_rms(hm_mode_model m, double conicity, double spee
   return HM_OK;
 }
 
+/* State s of the complex eigenvector whose real and imaginary parts are dgeev's columns k and k + 1 (d x d). */
+static double _Complex eigvec_at(const double *vr, size_t d, size_t s, size_t k) {
+  return vr[s + d * k] + I * vr[s + d * (k + 1)];
+}
+
 hm_status hm_mode_model_displacement_per_accel(hm_mode_model m, double conicity, double speed_kmh,
                                                const hm_sensor_point *point, double f_hz, double *out) {
   if (!m || !point || !out) return HM_EINVAL;
@@ -614,16 +619,12 @@ hm_status hm_mode_model_displacement_per_accel(hm_mode_model m, double conicity,
       k = (int)j;
   if (k < 0) return HM_ENOCRIT; /* (no mode there) */
   const double _Complex lam = re[k] + I * im[k];
-  double _Complex acc = 0.0; /* dgeev's pair: columns k (real part) and k + 1 (imaginary part) */
-  for (size_t j = 0; j < point->n_terms; ++j) {
-    const size_t s = (size_t)point->state[j];
-    acc += point->weight[j] * lam * (vr[s + d * (size_t)k] + I * vr[s + d * (size_t)(k + 1)]);
-  }
+  double _Complex acc = 0.0; /* the point's acceleration: lambda times its velocity states */
+  for (size_t j = 0; j < point->n_terms; ++j)
+    acc += point->weight[j] * lam * eigvec_at(vr, d, (size_t)point->state[j], (size_t)k);
   double most = 0.0;
-  for (size_t i = 0; i < sys->n_wheelsets; ++i) {
-    const size_t s = (size_t)sys->wheelset_y_state[i];
-    most = fmax(most, cabs(vr[s + d * (size_t)k] + I * vr[s + d * (size_t)(k + 1)]));
-  }
+  for (size_t i = 0; i < sys->n_wheelsets; ++i)
+    most = fmax(most, cabs(eigvec_at(vr, d, (size_t)sys->wheelset_y_state[i], (size_t)k)));
   const double r = most / cabs(acc);
   if (!(r > 0.0) || !isfinite(r)) return HM_ENONFINITE;
   *out = r;

@@ -87,6 +87,13 @@ static int minimise(fit_ctx *c, double lo, double hi, int scan, double tol, doub
   return 1;
 }
 
+/* The motion found within HM_SPECTRUM_FIT_MOTION_TOL of the one linearised about, for every wheelset. */
+static int motion_settled(const double *found, const double *about) {
+  for (size_t i = 0; i < HM_SYSTEM_MAX_WHEELSETS; ++i)
+    if (!(fabs(found[i] - about[i]) <= HM_SPECTRUM_FIT_MOTION_TOL * found[i])) return 0;
+  return 1;
+}
+
 static int options_ok(const hm_spectrum_fit_options *o) {
   return o && o->conicity_min > 0.0 && o->conicity_max > o->conicity_min && isfinite(o->conicity_max) &&
          o->tol > 0.0 && isfinite(o->tol) && o->window_s >= 0.0 && isfinite(o->window_s) &&
@@ -110,7 +117,6 @@ hm_status hm_spectrum_fit_conicity(hm_mode_model m, double speed_kmh, const hm_s
   run.window_s = o->window_s;
   fit_ctx c = {m, speed_kmh, point, &run, f_hz, psd, n, g, 0.0, 0.0};
   double lam, at_rest = NAN, motion[HM_SYSTEM_MAX_WHEELSETS] = {0.0};
-  const size_t nw = HM_SYSTEM_MAX_WHEELSETS;
   for (unsigned pass = 0;; ++pass) {
     /* the first over the range; each later one about the conicity before it (the motion changes it by 5-10%) */
     const int ok = pass == 0 ? minimise(&c, o->conicity_min, o->conicity_max, SCAN, o->tol, &lam)
@@ -121,17 +127,11 @@ hm_status hm_spectrum_fit_conicity(hm_mode_model m, double speed_kmh, const hm_s
     if (!isfinite(objective(&c, lam))) return HM_ENOCONV;
     if (hm_mode_model_motion_rms(m, lam, speed_kmh, &run, c.amp, motion) != HM_OK) return HM_ENOCONV;
     if (pass == o->passes) break;
-    /* converged: the motion linearised about and the one found within HM_SPECTRUM_FIT_MOTION_TOL of each other */
-    int settled = pass > 0;
-    for (size_t i = 0; i < nw; ++i)
-      settled = settled && fabs(motion[i] - run.motion_rms_m[i]) <= HM_SPECTRUM_FIT_MOTION_TOL * motion[i];
-    if (settled) break;
+    if (pass > 0 && motion_settled(motion, run.motion_rms_m)) break; /* converged */
     memcpy(run.motion_rms_m, motion, sizeof motion);
   }
-  if (o->passes > 0) { /* not settled within the passes: no conicity (a motion this large is no Gaussian's either) */
-    for (size_t i = 0; i < nw; ++i)
-      if (fabs(motion[i] - run.motion_rms_m[i]) > HM_SPECTRUM_FIT_MOTION_TOL * motion[i]) return HM_ENOCONV;
-  }
+  /* not settled within the passes: no conicity (a motion this large is no Gaussian's either) */
+  if (o->passes > 0 && !motion_settled(motion, run.motion_rms_m)) return HM_ENOCONV;
   const double l0 = objective(&c, lam), amp = c.amp, fl = c.floor_;
   double dev = 0.0, carried = 0.0, total = 0.0; /* Whittle's deviance: 2 sum (x - ln x - 1), x = p / m */
   for (size_t k = 0; k < n; ++k) {
