@@ -267,8 +267,7 @@ typedef struct {
   double edge_used_m;               /* the edge amplitude the amplitude rules use (0: none) */
   double margin_hopf_kmh;           /* Hopf speed - speed */
   double margin_lowest_cycle_kmh;   /* lowest cycle speed - speed (negative: inside the bistable band) */
-  double amplitude_m;               /* measured displacement amplitude used (the sensor's own; 0 for an oscillation
-                                       a displacement map cannot read: not the hunting mode, estimator.h) */
+  double amplitude_m;               /* measured displacement amplitude used */
   double amplitude_margin_m;        /* edge - amplitude (0 if no edge) */
   int latched;                      /* an oscillation ALARM held until the oscillation stays calm and the speed drops */
   double release_in_s;              /* calm still needed [s] (release_s while the oscillation or the speed is not

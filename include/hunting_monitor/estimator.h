@@ -126,8 +126,6 @@ typedef struct {
   double amplitude_displacement_m;/* the sensor's own, a / (2 pi f)^2; 0 if the frequency is not valid */
   double wheelset_displacement_m; /* with a displacement map (below): the wheelsets' it implies, which (c) judges; 0
                                      where it cannot tell or without a map */
-  int displacement_mapped;        /* a map is set: the oscillation is the hunting mode's only where it tells
-                                     (wheelset_displacement_m > 0; the alarm's amplitude rules read nothing else) */
   double period_spread;           /* relative standard deviation of the recent periods */
   double rms_mps2;                /* sliding r.m.s. over the window (or what is available of it) */
   int rms_window_complete;
@@ -165,9 +163,7 @@ typedef double (*hm_displacement_map_fn)(void *ctx, double f_hz, double speed_km
  * speed, a value <= 0) (c) does not judge. amplitude_displacement_m, which the alarm's amplitude rules read, stays the
  * sensor's own: a frame's ambient motion near the hunting frequency is not the mode's, and read through the mode's
  * shape it overstates the wheelsets' (2.6-4.8 mm for 1.1-2.0 mm, a review's); only a coherent oscillation is
- * taken for the mode. The alarm reads it only where the map tells (displacement_mapped, alarm.h): the frame's own 8-10
- * Hz motion near an estimated Hopf speed 32 km/h low, where the unstable cycle shrinks to nothing, had given ALARM 96 s
- * before 3 mm (the campaign's frame_452). NULL: no map. */
+ * taken for the mode. NULL: no map. */
 void hm_estimator_set_displacement_map(hm_estimator est, hm_displacement_map_fn fn, void *ctx);
 /* How many times the filters restarted (gaps, redesigns for a measured rate, resets), and the rate they are designed
  * for now: a consumer of the same stream (the modal identification) restarts with them. */

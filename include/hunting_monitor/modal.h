@@ -19,9 +19,10 @@
  *    is not a mode. The hunting mode is the less damped pair: averaged with a broad resonance at its frequency a
  *    single pair reads -2.5 1/s for a mode of -0.56 (issue #26). The two pairs are fitted from the last fit's where
  *    that held something (a ratio above half HM_MODAL_TWO_PAIR_LR_WEAK), and from two splits of the one pair every
- *    fifth fit. Only a converged two-pair fit is chosen; one still descending after its steps (a broad resonance and
- *    the numerator's cubic make a ridge the scoring crosses slowly) is a lower bound on the ratio: it can be the weak
- *    alternative (decay_rate_alt_1_s), and the next fit goes on from it.
+ *    fifth fit. Only a converged two-pair fit is chosen; an unfinished one (screened out after a few steps or out of
+ *    steps: a broad resonance and the numerator's cubic make a ridge the scoring crosses slowly) is a lower bound on
+ *    the ratio: it can be the weak alternative (decay_rate_alt_1_s, unless line-like), and the next fit goes on from
+ *    it.
  *  - Track lines are taken out in distance first where the window's speed moved them (order_lines.h: a line that
  *    swept many bins stands nowhere above its background, yet lies on the mode's peak; sharper in distance than in
  *    time, it is subtracted from the samples at its phase in distance). A reading as narrow as a line with such a
@@ -133,10 +134,11 @@ typedef struct {
   double second_frequency_hz, second_decay_rate_1_s; /* the other pair of two (0 with one) */
   double two_pair_lr;          /* 2 (L1 - L2) over the independent ordinates: two pairs are chosen above
                                   HM_MODAL_TWO_PAIR_LR when their fit converged (0 when none was tried or none ended
-                                  below the one pair; a fit still descending gives a lower bound) */
+                                  below the one pair; an unfinished fit gives a lower bound) */
   double decay_rate_alt_1_s;   /* with one pair chosen but two telling a mode beside another resonance at a likelihood
-                                  ratio above HM_MODAL_TWO_PAIR_LR_WEAK (their fit converged or still descending):
-                                  the two pairs' mode's decay rate (0: none).
+                                  ratio above HM_MODAL_TWO_PAIR_LR_WEAK (their fit converged; or unfinished, at any
+                                  ratio above it, its mode no narrower than 1 / T): the two pairs' mode's decay rate
+                                  (0: none).
                                   The evidence cannot choose: the margin counts the difference as an error of the
                                   decay rate (a broad resonance averaged with the mode reads it more damped) */
   double peak_core_z;          /* the periodogram's excess over the fit within half the mode's width of its frequency,
@@ -243,8 +245,8 @@ typedef struct {
  * anywhere: at 12 a chance bump on a broad mode's flank was read as a mode of -0.6 1/s in 0.5% of single-pole windows
  * and one such window of a campaign's ramp as a conicity change to 0.28). */
 #define HM_MODAL_TWO_PAIR_LR 20.0
-/* ... and between this and HM_MODAL_TWO_PAIR_LR (the chi-square's 5% point) the two pairs' mode is an alternative
- * reading (decay_rate_alt_1_s). */
+/* ... and between this and HM_MODAL_TWO_PAIR_LR (the chi-square's 5% point), or above this where the two-pair fit is
+ * unfinished, the two pairs' mode is an alternative reading (decay_rate_alt_1_s). */
 #define HM_MODAL_TWO_PAIR_LR_WEAK 8.0
 
 /* The reading as the window's estimate (its fields copied; the window's lines kept), and the estimate's own reading. */

@@ -110,31 +110,6 @@ static void levels_follow_the_boundaries(void) {
   hm_alarm_destroy(a);
 }
 
-/* A sensor read through a displacement map (estimator.h; a bogie frame with a vehicle model): an oscillation the map
- * cannot read (away from the hunting mode's frequency: the frame's own motion) is not the mode, and the amplitude rules
- * do not take it: 9 mm at 400 km/h, beyond the basin edge of about 8.35 mm there (MODEL.md section 7; the axle-box
- * case above is ALARM), stays OK; the same oscillation where the map tells (the wheelsets' displacement it implies
- * > 0) is ALARM beyond the edge, as from an axle box. */
-static void an_unmapped_oscillation_is_not_the_mode(void) {
-  const struct {
-    double wheelset_m;
-    hm_level level;
-    hm_reason reason;
-  } cases[] = {{0.0, HM_LEVEL_OK, HM_REASON_NORMAL}, {0.03, HM_LEVEL_ALARM, HM_REASON_AMPLITUDE_BEYOND_EDGE}};
-  for (size_t i = 0; i < sizeof cases / sizeof cases[0]; ++i) {
-    hm_alarm a = make();
-    hm_assessment s;
-    hm_estimate e = estimate(400.0, 0.009);
-    e.displacement_mapped = 1;
-    e.wheelset_displacement_m = cases[i].wheelset_m;
-    HM_CHECK(hm_alarm_update(a, &e, NULL, 10.0, &s) == HM_OK, "update");
-    HM_CHECK(s.level == cases[i].level && s.reason == cases[i].reason, "mapped %g m: %s (%s)", cases[i].wheelset_m,
-             hm_level_name(s.level), hm_reason_text(s.reason));
-    HM_CHECK_DELTA(s.amplitude_m, cases[i].wheelset_m > 0.0 ? 0.009 : 0.0, 1e-15, "the amplitude the rules read");
-    hm_alarm_destroy(a);
-  }
-}
-
 /* A stale input gives NO_DATA at once, with no boundaries presented; data back gives the level at once. */
 static void stale_input_is_no_data(void) {
   hm_alarm a = make();
@@ -1195,7 +1170,6 @@ int main(void) {
     return 1;
   }
   HM_RUN(levels_follow_the_boundaries);
-  HM_RUN(an_unmapped_oscillation_is_not_the_mode);
   HM_RUN(levels_with_a_conicity_estimate);
   HM_RUN(prior_before_identification);
   HM_RUN(stale_input_is_no_data);

@@ -668,10 +668,7 @@ static hm_status target_with_data(hm_alarm a, const hm_estimate *e, const hm_mar
   s->narrow_peak_ambiguous = g && g->ambiguous_at_s > 0.0 && now - g->ambiguous_at_s <= HM_ALARM_NARROW_HOLD_S;
   s->margin_hopf_kmh = s->boundaries.hopf_speed_kmh - e->speed_kmh;
   s->margin_lowest_cycle_kmh = s->boundaries.lowest_cycle_speed_kmh - e->speed_kmh;
-  /* a sensor read through a displacement map (estimator.h): an oscillation it cannot read, away from the hunting mode's
-   * frequency (a frame's own 8-10 Hz motion), is not the mode, and the unstable cycle's amplitude is the wheelsets' */
-  const int not_the_mode = e->displacement_mapped && !(e->wheelset_displacement_m > 0.0);
-  s->amplitude_m = e->oscillation_valid && !not_the_mode ? e->amplitude_displacement_m : 0.0;
+  s->amplitude_m = e->oscillation_valid ? e->amplitude_displacement_m : 0.0;
   s->amplitude_margin_m = s->edge_used_m > 0.0 ? s->edge_used_m - s->amplitude_m : 0.0;
   hunted_bound(a, e, now, s);
   follow_trend(a, now, e->speed_kmh);

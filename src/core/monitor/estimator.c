@@ -473,7 +473,6 @@ void hm_estimator_read(const hm_estimator e, double now, hm_estimate *out) {
   r.amplitude_displacement_m = r.oscillation_valid ? r.amplitude_accel_mps2 / (w * w) : 0.0;
   double judged_m = r.amplitude_displacement_m; /* what (c) judges: the sensor's own, or the wheelsets' by the map */
   r.wheelset_displacement_m = 0.0;
-  r.displacement_mapped = e->disp_map != NULL;
   if (e->disp_map) {
     const double s = r.oscillation_valid && r.speed_valid ? e->disp_map(e->disp_ctx, r.frequency_hz, r.speed_kmh) : 0.0;
     r.wheelset_displacement_m = s > 0.0 && isfinite(s) ? r.amplitude_accel_mps2 * s : 0.0;

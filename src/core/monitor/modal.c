@@ -488,12 +488,14 @@ static int best_of(const hm_whittle_data *d, unsigned poles, const double (*star
 
 /* The best two-pair fit from the starts given (the choice needs the objective to HM_MODAL_TOL2 only); a start whose
  * objective after HM_MODAL_SCREEN_ITER2 steps is not within half the choice's margin of the one pair's obj1 is
- * given up (a second pair that far off is not there), the others get HM_MODAL_MAX_ITER2 steps in all. 1 if any
- * start ended below obj1 (th, obj, f set: a converged fit's, else the lowest still descending; *converged says
- * which). A fit still descending bounds the two pairs' likelihood ratio from below: a broad resonance beside the mode
- * sits on a ridge with the numerator's cubic that the scoring crosses slowly (20 s windows of -1.57 1/s at 14.15 Hz
- * beside -5.75 at 13.66 Hz: 80 steps ended still descending at ratios of 6-10 with the mode at -1.7 to -2.0, where
- * one pair read -2.4 to -4.7), and it is followed from fit to fit (the warm start) so that the descent goes on. */
+ * screened out (not scored further: a second pair that far off is not there, or not yet), the others get
+ * HM_MODAL_MAX_ITER2 steps in all. 1 if any start ended below obj1 (th, obj, f set: a converged fit's, else the lowest
+ * unfinished one, screened out or out of steps; *converged says which). An unfinished fit bounds the two pairs'
+ * likelihood ratio from below, and it is followed from fit to fit (the warm start) so that the descent goes on a few
+ * steps a fit: a broad resonance beside the mode sits on a ridge with the numerator's cubic that the scoring crosses
+ * slowly (broad_386's 20 s windows, -1.57 1/s at 14.15 Hz beside -5.75 at 13.66 Hz: screened out at ratios of 3-10
+ * with the mode at -1.7 to -2.0, where one pair read -2.4 to -4.7; given 80 steps most converged at ratios of 10-16
+ * with the same mode). */
 static int fit_two_pairs(const hm_modal m, const hm_whittle_data *d, const window_geometry *g,
                          const double (*starts)[NPM], int n_starts, double obj1, double *th, double *obj,
                          double f[NPM][NPM], int *converged, unsigned *iters) {
@@ -586,13 +588,18 @@ static int fit_reading(hm_modal m, warm_start *ws, const window_geometry *g, siz
    * the splits look again (a second pair warm-started at every fit for nothing was 45% of a ramp's scoring steps) */
   ws->have2 = found2 && lr > HM_MODAL_WARM2_MIN_LR && in_band(m, th2[HM_W_W0]) && in_band(m, th2[HM_W_W02]);
   if (found2) memcpy(ws->th2, th2, sizeof th2);
-  const int tells = found2 && lr > HM_MODAL_TWO_PAIR_LR_WEAK && two_pairs_tell(m, g, th2, th1);
+  /* an unfinished fit's line-like pair (narrower than the window resolves, 1 / T) is no alternative: a finished one
+   * there reads sigma = 0, none (a joint's line beside a mode of -10.4 1/s had read -0.0009 and added 10.4 to its
+   * error) */
+  const double alt = -fmin(fabs(th2[HM_W_SIGMA]), fabs(th2[HM_W_SIGMA2]));
+  const int tells = found2 && lr > HM_MODAL_TWO_PAIR_LR_WEAK && (conv2 || -alt >= 1.0 / g->T) &&
+                    two_pairs_tell(m, g, th2, th1);
   const int two = tells && conv2 && lr > HM_MODAL_TWO_PAIR_LR;
   *poles = two ? 2 : 1;
   memcpy(th, two ? th2 : th1, sizeof(double) * NPM);
   reading_of(m, g, &d, th, *poles, two ? (const double(*)[NPM])f2 : (const double(*)[NPM])f1, r);
   r->two_pair_lr = lr;
-  r->decay_rate_alt_1_s = tells && !two ? -fmin(fabs(th2[HM_W_SIGMA]), fabs(th2[HM_W_SIGMA2])) : 0.0;
+  r->decay_rate_alt_1_s = tells && !two ? alt : 0.0;
   r->iterations = iters;
   return 1;
 }
