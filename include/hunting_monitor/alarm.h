@@ -1,6 +1,8 @@
 /*
- * hunting_monitor - safety margins and alarm levels from the estimator, the hunting-mode margin and the boundary
- * tables (docs/MODEL.md sections 4-7, issue #9).
+ * hunting_monitor - safety margins and alarm levels from the estimator and the Hopf interval with its boundaries
+ * (docs/MODEL.md sections 4-7, issue #9). The interval is built beside the alarm (interval.h: the prior, the margin's
+ * estimates and the boundary table) and handed to each update; the rules it is weighed by are stated here, with the
+ * levels they lead to. The alarm decides levels only.
  *
  * The conicity in use and the Hopf interval [hopf_low, hopf_high] the level uses come from what is known:
  *  - identified: the margin's model-based estimate (margin.h) with a standard error of at most conicity_max_se (once
@@ -23,7 +25,7 @@
  *    prior's alone (far below the Hopf speed an uncertain window's conicity leans on the model: one window at 345 km/h
  *    as 0.18 +- 0.02 for 0.12, and the more cautious end gave WARN 120 km/h below the truth);
  *  - the model-based interval is not used at all when the vehicle does not behave like its model (model_mismatch)
- *    or the accelerometer is not on an axle box (hm_alarm_set_measurement_point): the prior, bounded by the
+ *    or the accelerometer is not on an axle box (hm_interval_set_measurement_point): the prior, bounded by the
  *    model-free interval;
  *  - the model-free interval (margin.h), when valid, bounds the level as well: its lower end with model_mismatch, a
  *    sensor off the axle box, or from HM_ALARM_FREE_MIN_WINDOWS windows on with a lightly damped mode held (margin.h's
@@ -109,6 +111,7 @@
 #include <stddef.h>
 
 #include "hunting_monitor/estimator.h"
+#include "hunting_monitor/interval.h"
 #include "hunting_monitor/margin.h"
 #include "hunting_monitor/status.h"
 #include "hunting_monitor/tables.h"
@@ -308,17 +311,16 @@ size_t hm_assessment_reason_text(const hm_assessment *s, double t_origin_s, char
 
 typedef struct hm_alarm_s *hm_alarm;
 
-/* The table is borrowed and must outlive the alarm; the fallback conicity 0 becomes veh's lambda(0). HM_EDOMAIN
- * (reason in why) for a bad configuration; *out untouched on failure. */
-hm_status hm_alarm_create(const hm_alarm_config *cfg, const hm_vehicle *veh, const hm_table table, hm_alarm *out,
-                          char *why, size_t why_len);
+/* HM_EDOMAIN (reason in why) for a bad configuration; *out untouched on failure. The Hopf interval and the boundaries
+ * come with each update (interval.h), as the monitor builds them. */
+hm_status hm_alarm_create(const hm_alarm_config *cfg, hm_alarm *out, char *why, size_t why_len);
 void hm_alarm_destroy(hm_alarm alarm);
 /* Back to NO_DATA / starting, forgetting a latch and a hunted-at speed (a new vehicle, a fresh start). */
 void hm_alarm_reset(hm_alarm alarm);
 /* The time line restarted (a clock step, a bag looped; times before are not comparable with times after): a held
  * ALARM stays held with its cause (a latch carries no times that matter) and the hunted-at speed stays a bound (its
- * age counts again from the next update); the level's hold, the calm seen, the speed's trend and the margin's flags
- * held against chatter (HM_ALARM_FLAG_CLEAR_S) start again. */
+ * age counts again from the next update); the level's hold, the calm seen and the speed's trend start again (the
+ * margin's flags held against chatter: hm_interval_restart). */
 void hm_alarm_restart(hm_alarm alarm);
 /* The time line moved by delta_s (a known step): every time the alarm holds moves with it, so ages are kept. */
 void hm_alarm_shift_time(hm_alarm alarm, double delta_s);
@@ -326,37 +328,24 @@ void hm_alarm_shift_time(hm_alarm alarm, double delta_s);
  * (default 900: the margin's memory_s, which the monitor passes). */
 void hm_alarm_set_memory(hm_alarm alarm, double memory_s);
 /* New settings from the next update on, the level and its hold kept (validated as at create: HM_EDOMAIN with the
- * reason in why, and nothing changes); the fallback conicity 0 becomes veh's lambda(0). */
-hm_status hm_alarm_set_config(hm_alarm alarm, const hm_alarm_config *cfg, const hm_vehicle *veh, char *why,
-                              size_t why_len);
-/* Where the accelerometer is (estimator.h; HM_POINT_WHEELSET by default): the model-based interval counts for the
- * level only from an axle box; from a bogie frame the model-free one carries it with the prior (a wheelset model does
- * not hold the frame's modes: a frame sensor read -6.3 1/s where the bogie's least damped mode was -0.98, issue #26). */
-void hm_alarm_set_measurement_point(hm_alarm alarm, hm_measurement_point point);
-/* Hopf speeds from a bogie's or car's model (mode_model.h's curve) instead of the wheelset's closed form, the prior's
- * recomputed; with such a model a bogie-frame sensor's model-based interval counts (the model holds the frame).
- * Borrowed; NULL returns to the wheelset. */
-hm_status hm_alarm_set_model(hm_alarm alarm, hm_mode_model model);
-/* The prior's conicity range in use (resolved for the vehicle: alarm_config's conicity_prior_low/high or the fallback
- * -+ HM_ALARM_PRIOR_HALFWIDTH). */
-void hm_alarm_prior(const hm_alarm alarm, double *conicity_low, double *conicity_high);
-/* Look boundaries up in this table from the next update on (borrowed, as at create; the level is kept). */
-void hm_alarm_set_table(hm_alarm alarm, const hm_table table);
+ * reason in why, and nothing changes). */
+hm_status hm_alarm_set_config(hm_alarm alarm, const hm_alarm_config *cfg, char *why, size_t why_len);
+/* The settings of the alarm's section that the interval is weighed by (interval.h). */
+void hm_alarm_interval_config(const hm_alarm_config *cfg, hm_interval_config *out);
 
 /* The displacement criterion's limit [m] (estimator.h) that the latch's calm test scales (0, the default: the edge
  * amplitude in use, or 2.1 mm without one). The monitor passes its estimator's. */
 void hm_alarm_set_displacement_limit(hm_alarm alarm, double displacement_limit_m);
-/* Evaluate at time now_s with the estimator's output and the margin's (margin may be NULL: no estimate).
- * HM_EINVAL for NULL arguments or a non-finite now; the table lookup's status if it fails. The alarm's state and
- * *out are untouched on failure. */
-hm_status hm_alarm_update(hm_alarm alarm, const hm_estimate *est, const hm_margin_estimate *margin, double now_s,
+/* Evaluate at time now_s with the estimator's output and the Hopf interval of the same time (interval.h's
+ * hm_interval_update at the estimate's speed; may be NULL without current acceleration or speed). HM_EINVAL for NULL
+ * arguments (the interval with current data) or a non-finite now: the alarm's state and *out are untouched then. */
+hm_status hm_alarm_update(hm_alarm alarm, const hm_estimate *est, const hm_hopf_interval *interval, double now_s,
                           hm_assessment *out);
 
 /* What the alarm holds that must outlive a restart (state.h), times as ages before a "now" [s]: a held ALARM with its
- * cause, the hunted-at speed while it counts (during the hold and memory_s after it), whether the estimate was in
- * use alone, the hysteresis of conicity_max_se (se_ok) and a dropped estimate's wait before it is used alone again
- * (precise_lost: the wait starts again, its full HM_ALARM_FLAG_CLEAR_S, at the restore). The level's hold, the calm
- * seen and the speed's trend start again, as at hm_alarm_restart. */
+ * cause and the hunted-at speed while it counts (during the hold and memory_s after it); what the interval's
+ * weighing remembers is interval.h's hm_interval_snapshot. The level's hold, the calm seen and the speed's trend start
+ * again, as at hm_alarm_restart. */
 typedef struct {
   int latched;              /* an oscillation ALARM held */
   hm_reason latch_reason;   /* its cause (a criterion, or the amplitude beyond the unstable cycle) */
@@ -364,18 +353,15 @@ typedef struct {
   double hunted_age_s;      /* how long ago its memory_s started [s] (when it was met, or the latch's release if
                                later; restored, it is also the time shown as hunted_at_s); NAN: its age counts from
                                the next update (a restarted time line) */
-  int precise;              /* the estimate was in use alone at the last update with data */
-  int se_ok;                /* its standard error was within conicity_max_se (once so, 1.25 times it) */
-  int precise_lost;         /* it had stopped being used alone and was waiting to be used so again */
 } hm_alarm_snapshot;
 
 /* What a holds as of now_s (its time line), ages clamped at 0; nothing is written for NULL or a non-finite now_s. */
 void hm_alarm_take_snapshot(const hm_alarm alarm, double now_s, hm_alarm_snapshot *out);
-/* Every field in its range (HM_EDOMAIN, "field: reason" in why): latched, precise, se_ok and precise_lost 0 or 1, a latch's cause an
+/* Every field in its range (HM_EDOMAIN, "field: reason" in why): latched 0 or 1, a latch's cause an
  * oscillation's, the hunted-at speed in (0, 2000] km/h or INFINITY, its age finite and >= 0 or NAN. */
 hm_status hm_alarm_snapshot_validate(const hm_alarm_snapshot *snap, char *why, size_t why_len);
 /* As hm_alarm_reset, then snap's latch (the level ALARM with its cause, as hm_alarm_restart keeps it), hunted-at speed
- * (its age counted back from now_s) and hysteresis. HM_EINVAL for NULL or a non-finite now_s, HM_EDOMAIN (reason in
+ * (its age counted back from now_s). HM_EINVAL for NULL or a non-finite now_s, HM_EDOMAIN (reason in
  * why) for an invalid snap; the alarm untouched on failure. */
 hm_status hm_alarm_restore(hm_alarm alarm, double now_s, const hm_alarm_snapshot *snap, char *why, size_t why_len);
 

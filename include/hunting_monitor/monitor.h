@@ -2,7 +2,8 @@
  * hunting_monitor - the online monitor: one object that the ROS node, `hunting estimate` and the tests share.
  *
  * It owns the streaming estimator (estimator.h), the hunting-mode identification (modal.h), the margin
- * (margin.h), the alarm (alarm.h) and the boundary table (tables.h), and holds the start-up policy:
+ * (margin.h), the Hopf interval built from the margin's estimates, the prior and the boundary table (interval.h,
+ * tables.h) and the alarm that decides levels on it (alarm.h), and holds the start-up policy:
  *  - the table: a given one must have been made for this vehicle (hm_table_check_vehicle: stiffnesses and every
  *    Hopf speed against the closed form); without one it is computed for the vehicle (table_n_conicity conicities);
  *  - the conicity fallback: the alarm's conicity_fallback, or the vehicle's own lambda(0) when that is 0 (so a
@@ -155,18 +156,20 @@ hm_status hm_monitor_replace_table(hm_monitor m, hm_table table, hm_table *repla
 void hm_monitor_vehicle(const hm_monitor m, hm_vehicle *veh);
 
 /* What the monitor has learned, kept through a restart (state.h writes it as bytes): the margin's windows, misfits,
- * change state and narrow-peak verdicts, and the alarm's latch, hunted-at speed and hysteresis, with times as ages
+ * change state and narrow-peak verdicts, the alarm's latch and hunted-at speed, and the interval's memory of the
+ * estimate's use (interval.h), with times as ages
  * before a "now" [s]. The stream (estimator, identification, the steady stretch) is not in it: it restarts. */
 typedef struct {
   hm_margin_snapshot margin;
   hm_alarm_snapshot alarm;
+  hm_interval_snapshot interval; /* whether the estimate was in use alone, its error's hysteresis and wait */
 } hm_monitor_snapshot;
 
 /* What m holds as of now_s (its time line); nothing is written for NULL or a non-finite now_s. */
 void hm_monitor_take_snapshot(const hm_monitor m, double now_s, hm_monitor_snapshot *out);
 /* Replace what m has learned by snap, its ages counted back from now_s (m's time line, which may be another than the
- * one snap was taken on): the stream restarts (as at hm_monitor_reset), then the margin and the alarm take snap's
- * (hm_margin_restore, hm_alarm_restore; a held ALARM is held again). HM_EINVAL for NULL or a non-finite now_s,
+ * one snap was taken on): the stream restarts (as at hm_monitor_reset), then the margin, the interval and the alarm
+ * take snap's (hm_margin_restore, hm_interval_restore, hm_alarm_restore; a held ALARM is held again). HM_EINVAL for NULL or a non-finite now_s,
  * HM_EDOMAIN (reason in why) for an invalid snap, checked as a whole first: m untouched on failure. */
 hm_status hm_monitor_restore(hm_monitor m, double now_s, const hm_monitor_snapshot *snap, char *why, size_t why_len);
 

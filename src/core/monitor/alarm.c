@@ -7,17 +7,10 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "hunting_monitor/linear.h"
-#include "evidence.h"
 #include "validate.h"
 
 struct hm_alarm_s {
-  hm_alarm_config cfg;            /* fallback and prior resolved for the vehicle */
-  hm_vehicle veh;
-  hm_mode_model model;            /* a bogie's or car's (hm_alarm_set_model; borrowed), NULL: the wheelset's */
-  double prior_hopf_low_kmh, prior_hopf_high_kmh; /* closed-form Hopf speeds at the prior's high and low ends */
-  double fallback_hopf_kmh;                       /* and at the fallback conicity (resolved with them) */
-  hm_table table;
+  hm_alarm_config cfg;
   hm_level level;
   hm_reason reason;
   double since;
@@ -30,7 +23,6 @@ struct hm_alarm_s {
   int calm;               /* the release conditions hold since calm_since */
   double calm_since;
   double displacement_limit_m; /* the displacement criterion's limit (0: off) */
-  hm_measurement_point point; /* where the accelerometer is */
   double hunted_at_kmh;   /* the lowest speed at which a criterion was met, during the latch and for memory_s after
                              it (INFINITY: none) */
   double hunted_t_s;      /* when (the latest time it was met there or lower); NAN: on a time line that restarted,
@@ -38,7 +30,6 @@ struct hm_alarm_s {
   double hunted_mem_s;    /* when its memory_s started: hunted_t_s, or the latch's release if later (alarm.h: for
                              memory_s after the release; a latch longer than memory_s had dropped it at once) */
   double memory_s;        /* how long a hunted-at speed bounds the interval (hm_alarm_set_memory) */
-  hm_evidence ev;         /* which estimates count, and their flags' memory (evidence.h) */
   double v_prev_kmh, t_prev_s, dvdt_kmh_s; /* the speed's trend: an exponential average of dv/dt over ~5 s */
   int have_trend;
   /* a sustained acceleration (alarm.h): the last speed, the mean of the block being filled and of the full blocks of
@@ -46,13 +37,6 @@ struct hm_alarm_s {
   double v_last_kmh, block_sum_kmh, block_sum_t_s, block_t0_s, block_last_s;
   unsigned block_n, n_blocks;
   double block_v_kmh[HM_ALARM_ACCEL_MAX_BLOCKS], block_t_s[HM_ALARM_ACCEL_MAX_BLOCKS]; /* oldest first */
-  /* the last table lookups (at the conicity in use and at the interval's optimistic end), reused while their
-   * conicity and the speed are unchanged */
-  struct {
-    int valid;
-    double conicity, speed_kmh;
-    hm_table_lookup_result r;
-  } cache[2];
 };
 
 const char *hm_level_name(hm_level l) {
@@ -169,11 +153,6 @@ hm_status hm_alarm_config_validate(const hm_alarm_config *c, char *why, size_t l
       {"hysteresis_kmh", c->hysteresis_kmh, HM_RULE_RANGE, 0.0, 100.0},
       {"hysteresis_amplitude_fraction", c->hysteresis_amplitude_fraction, HM_RULE_RANGE, 0.0, 1.0},
       {"min_hold_s", c->min_hold_s, HM_RULE_RANGE, 0.0, 3600.0},
-      {"use_conicity_estimate", (double)c->use_conicity_estimate, HM_RULE_FLAG, 0.0, 0.0},
-      {"conicity_max_se", c->conicity_max_se, HM_RULE_RANGE_OPEN, 0.0, 1.0},
-      {"conicity_fallback", c->conicity_fallback, HM_RULE_RANGE, 0.0, 10.0},
-      {"conicity_prior_low", c->conicity_prior_low, HM_RULE_RANGE, 0.0, 10.0},
-      {"conicity_prior_high", c->conicity_prior_high, HM_RULE_RANGE, 0.0, 10.0},
       {"blind_fraction", c->blind_fraction, HM_RULE_RANGE_OPEN, 0.0, 1.0},
       {"release_s", c->release_s, HM_RULE_RANGE, 0.0, 3600.0},
       {"release_amplitude_fraction", c->release_amplitude_fraction, HM_RULE_RANGE_OPEN, 0.0, 1.0}};
@@ -185,55 +164,29 @@ hm_status hm_alarm_config_validate(const hm_alarm_config *c, char *why, size_t l
   if (!(c->hysteresis_amplitude_fraction < c->warn_amplitude_fraction))
     return hm_reject(why, len, "hysteresis_amplitude_fraction", "must be below warn_amplitude_fraction",
                      c->hysteresis_amplitude_fraction);
-  if ((c->conicity_prior_low == 0.0) != (c->conicity_prior_high == 0.0) ||
-      (c->conicity_prior_high != 0.0 && !(c->conicity_prior_high > c->conicity_prior_low)))
-    return hm_reject(why, len, "conicity_prior_high",
-                     "must be above conicity_prior_low (or both 0: the fallback -+ 0.03)", c->conicity_prior_high);
-  return HM_OK;
+  hm_interval_config ic;
+  hm_alarm_interval_config(c, &ic);
+  return hm_interval_config_validate(&ic, why, len);
 }
 
-/* The Hopf speed at a conicity: the vehicle model's curve, or the wheelset's closed form. */
-static double hopf_kmh(const hm_vehicle *veh, hm_mode_model model, double conicity) {
-  return model ? hm_mode_model_hopf_kmh(model, conicity) : hm_linear_hopf_kmh(veh, conicity);
+void hm_alarm_interval_config(const hm_alarm_config *c, hm_interval_config *out) {
+  if (!c || !out) return;
+  out->use_conicity_estimate = c->use_conicity_estimate;
+  out->conicity_max_se = c->conicity_max_se;
+  out->conicity_fallback = c->conicity_fallback;
+  out->conicity_prior_low = c->conicity_prior_low;
+  out->conicity_prior_high = c->conicity_prior_high;
 }
 
-/* The configuration with the fallback and the prior resolved for the vehicle, and the prior's Hopf speeds; HM_EDOMAIN
- * (reason in why) for a prior that does not hold the fallback. */
-static hm_status resolve(const hm_alarm_config *cfg, const hm_vehicle *veh, hm_mode_model model, hm_alarm_config *out,
-                         double *hopf_low, double *hopf_high, double *hopf_fallback, char *why, size_t len) {
-  hm_status st = hm_alarm_config_validate(cfg, why, len);
-  if (st != HM_OK) return st;
-  hm_alarm_config c = *cfg;
-  if (c.conicity_fallback == 0.0) hm_conicity_eval(&veh->conicity, 0.0, &c.conicity_fallback, NULL);
-  if (c.conicity_prior_low == 0.0 && c.conicity_prior_high == 0.0) {
-    c.conicity_prior_low = fmax(c.conicity_fallback - HM_ALARM_PRIOR_HALFWIDTH, 0.5 * c.conicity_fallback);
-    c.conicity_prior_high = c.conicity_fallback + HM_ALARM_PRIOR_HALFWIDTH;
-  }
-  if (!(c.conicity_prior_low <= c.conicity_fallback && c.conicity_fallback <= c.conicity_prior_high)) {
-    if (why && len)
-      snprintf(why, len, "conicity_prior_low, conicity_prior_high: must hold the fallback conicity %g (got %g..%g)",
-               c.conicity_fallback, c.conicity_prior_low, c.conicity_prior_high);
-    return HM_EDOMAIN;
-  }
-  *out = c;
-  *hopf_low = hopf_kmh(veh, model, c.conicity_prior_high);
-  *hopf_high = hopf_kmh(veh, model, c.conicity_prior_low);
-  *hopf_fallback = hopf_kmh(veh, model, c.conicity_fallback);
-  return HM_OK;
-}
-
-hm_status hm_alarm_create(const hm_alarm_config *cfg, const hm_vehicle *veh, const hm_table table, hm_alarm *out,
-                          char *why, size_t why_len) {
-  if (!cfg || !veh || !table || !out) return HM_EINVAL;
+hm_status hm_alarm_create(const hm_alarm_config *cfg, hm_alarm *out, char *why, size_t why_len) {
+  if (!cfg || !out) return HM_EINVAL;
   hm_alarm a = calloc(1, sizeof *a);
   if (!a) return HM_ENOMEM;
-  const hm_status st = hm_alarm_set_config(a, cfg, veh, why, why_len);
+  const hm_status st = hm_alarm_set_config(a, cfg, why, why_len);
   if (st != HM_OK) {
     free(a);
     return st;
   }
-  a->table = table;
-  a->ev.precise_since = NAN;
   a->hunted_at_kmh = INFINITY;
   a->memory_s = 900.0;
   a->level = HM_LEVEL_NO_DATA;
@@ -261,11 +214,9 @@ void hm_alarm_restart(hm_alarm a) {
   a->calm = 0;
   a->hunted_t_s = a->hunted_mem_s = NAN; /* its age counts again from the next update */
   a->latch_since_s = a->latch_last_met_s = NAN;
-  hm_evidence_restart(&a->ev);
   a->have_trend = 0;
   a->dvdt_kmh_s = 0.0;
   a->block_n = a->n_blocks = 0;
-  a->cache[0].valid = a->cache[1].valid = 0;
 }
 
 void hm_alarm_shift_time(hm_alarm a, double delta_s) {
@@ -274,7 +225,6 @@ void hm_alarm_shift_time(hm_alarm a, double delta_s) {
   a->lower_since += delta_s;
   a->calm_since += delta_s;
   a->t_prev_s += delta_s;
-  hm_evidence_shift_time(&a->ev, delta_s);
   a->hunted_t_s += delta_s;
   a->hunted_mem_s += delta_s;
   a->latch_since_s += delta_s;
@@ -286,24 +236,6 @@ void hm_alarm_shift_time(hm_alarm a, double delta_s) {
 
 void hm_alarm_set_memory(hm_alarm a, double memory_s) {
   if (a && isfinite(memory_s) && memory_s > 0.0) a->memory_s = memory_s;
-}
-
-hm_status hm_alarm_set_model(hm_alarm a, hm_mode_model model) {
-  if (!a) return HM_EINVAL;
-  a->model = model;
-  const hm_alarm_config cfg = a->cfg;
-  const hm_vehicle veh = a->veh;
-  return hm_alarm_set_config(a, &cfg, &veh, NULL, 0); /* the prior's Hopf speeds from the model */
-}
-
-void hm_alarm_set_measurement_point(hm_alarm a, hm_measurement_point point) {
-  if (a && (point == HM_POINT_WHEELSET || point == HM_POINT_BOGIE_FRAME)) a->point = point;
-}
-
-void hm_alarm_prior(const hm_alarm a, double *lo, double *hi) {
-  if (!a) return;
-  if (lo) *lo = a->cfg.conicity_prior_low;
-  if (hi) *hi = a->cfg.conicity_prior_high;
 }
 
 void hm_alarm_set_displacement_limit(hm_alarm a, double limit_m) {
@@ -331,30 +263,16 @@ static void release_conditions(const hm_alarm a, const hm_estimate *e, hm_assess
   if (!(e->speed_kmh < s->hold_release_below_kmh)) s->hold_waits |= HM_HOLD_WAITS_SPEED;
 }
 
-hm_status hm_alarm_set_config(hm_alarm a, const hm_alarm_config *cfg, const hm_vehicle *veh, char *why,
-                              size_t why_len) {
-  if (!a || !cfg || !veh) return HM_EINVAL;
-  hm_alarm_config c;
-  double lo, hi, at_fallback;
-  const hm_status st = resolve(cfg, veh, a->model, &c, &lo, &hi, &at_fallback, why, why_len);
+hm_status hm_alarm_set_config(hm_alarm a, const hm_alarm_config *cfg, char *why, size_t why_len) {
+  if (!a || !cfg) return HM_EINVAL;
+  const hm_status st = hm_alarm_config_validate(cfg, why, why_len);
   if (st != HM_OK) return st;
-  a->cfg = c;
-  a->veh = *veh;
-  a->prior_hopf_low_kmh = lo;
-  a->prior_hopf_high_kmh = hi;
-  a->fallback_hopf_kmh = at_fallback;
-  a->cache[0].valid = a->cache[1].valid = 0; /* the conicity in use may change with the settings */
+  a->cfg = *cfg;
   return HM_OK;
 }
 
-void hm_alarm_set_table(hm_alarm a, const hm_table table) {
-  if (!a || !table) return;
-  a->table = table;
-  a->cache[0].valid = a->cache[1].valid = 0; /* the cached lookups were the old table's */
-}
-
 /* The level the conditions call for, with the thresholds of levels at or below `current` relaxed. */
-static hm_level raw_level(const hm_alarm a, const hm_estimate *e, const hm_margin_estimate *g, const hm_assessment *s,
+static hm_level raw_level(const hm_alarm a, const hm_estimate *e, const hm_hopf_interval *iv, const hm_assessment *s,
                           hm_level current, hm_reason *reason) {
   const hm_alarm_config *c = &a->cfg;
   const double v = e->speed_kmh, amp = s->amplitude_m, edge = s->edge_used_m;
@@ -375,40 +293,12 @@ static hm_level raw_level(const hm_alarm a, const hm_estimate *e, const hm_margi
   if (v_ahead >= s->watch_from_kmh - hv_watch)
     return *reason = HM_REASON_APPROACHING_HOPF, HM_LEVEL_WATCH;
   if (s->model_mismatch) return *reason = HM_REASON_MODEL_MISMATCH, HM_LEVEL_WATCH;
-  if (g && g->conicity_valid && g->outside_prior && c->use_conicity_estimate)
-    return *reason = HM_REASON_OUTSIDE_PRIOR, HM_LEVEL_WATCH;
+  if (iv->outside_prior) return *reason = HM_REASON_OUTSIDE_PRIOR, HM_LEVEL_WATCH;
   if (s->narrow_peak_ambiguous) return *reason = HM_REASON_NARROW_PEAK, HM_LEVEL_WATCH;
   if (e->sample_rate_mismatch) return *reason = HM_REASON_RATE_MISMATCH, HM_LEVEL_WATCH;
   if (e->loss_fraction > c->blind_fraction) return *reason = HM_REASON_PARTLY_BLIND, HM_LEVEL_WATCH;
   if (v < s->boundaries.lowest_cycle_speed_kmh) return *reason = HM_REASON_BELOW_LOWEST_CYCLE, HM_LEVEL_OK;
   return *reason = HM_REASON_NORMAL, HM_LEVEL_OK;
-}
-
-/* The table's boundaries at (conicity, speed) through cache slot k. Outside the table's conicities the widened
- * lookup (tables.h: the cautious of the end conicity's and the extrapolated, not the end's alone; alarm.h); where the
- * extrapolation has no Hopf speed, the clamped lookup with the closed-form Hopf speed. */
-static hm_status lookup(hm_alarm a, int k, double conicity, double speed_kmh, hm_table_lookup_result *out) {
-  if (a->cache[k].valid && a->cache[k].conicity == conicity && a->cache[k].speed_kmh == speed_kmh) {
-    *out = a->cache[k].r;
-    return HM_OK;
-  }
-  hm_table_lookup_result r;
-  hm_status st = hm_table_lookup_widened(a->table, conicity, speed_kmh, &r);
-  if (st == HM_EDOMAIN && isfinite(conicity) && isfinite(speed_kmh)) st = hm_table_lookup(a->table, conicity, speed_kmh, &r);
-  if (st != HM_OK) return st;
-  const int clamped = r.conicity != conicity && !r.widened;
-  if (clamped || a->model) {
-    const double v = hopf_kmh(&a->veh, a->model, conicity);
-    if (clamped) r.hopf_speed_kmh = v;
-    /* a model's Hopf curve is exact to HM_MODE_MODEL_CURVE_ERR_KMH where the table interpolates */
-    if (a->model && v < HM_LINEAR_NO_HOPF_KMH) r.hopf_speed_kmh = v, r.error_speed_kmh = HM_MODE_MODEL_CURVE_ERR_KMH;
-  }
-  a->cache[k].valid = 1;
-  a->cache[k].conicity = conicity;
-  a->cache[k].speed_kmh = speed_kmh;
-  a->cache[k].r = r;
-  *out = r;
-  return HM_OK;
 }
 
 /* The block being filled joins the full ones (the oldest dropped when the ring is full). */
@@ -478,68 +368,39 @@ static double warn_below_point(double point_kmh, double low_kmh, double margin_k
  * estimate too uncertain to be used alone (the vehicle behaving like its model) gives its own WARN threshold so, and
  * the more cautious of it and the prior's range counts. warn_risk: what the WARN rule risks (the interval read as
  * normal, its lower half-width interval_z standard errors). */
-static void speed_thresholds(const hm_alarm a, const hm_margin_estimate *g, const hm_evidence_interval *ev,
-                             hm_assessment *s) {
+static void speed_thresholds(const hm_alarm a, const hm_hopf_interval *iv, hm_assessment *s) {
   const hm_alarm_config *c = &a->cfg;
+  const int precise = iv->conicity_from_estimate;
   const hm_table_lookup_result *b = &s->boundaries;
-  const double h = ev->precise ? b->hopf_speed_kmh - s->hopf_low_kmh : 0.0;
-  const double from = ev->precise ? b->hopf_speed_kmh : s->hopf_low_kmh;
-  const double z = g && g->interval_z > 0.0 ? g->interval_z : 1.0;
+  const double h = precise ? b->hopf_speed_kmh - s->hopf_low_kmh : 0.0;
+  const double from = precise ? b->hopf_speed_kmh : s->hopf_low_kmh;
+  const double z = iv->interval_z;
   s->warn_from_kmh =
-      warn_below_point(from, ev->precise ? s->hopf_low_kmh : from, c->warn_speed_margin_kmh, z, c->warn_standard_errors);
-  if (ev->usable && !ev->precise) {
-    const double lo_e = ev->free_counts ? fmin(g->hopf_model_low_kmh, a->ev.free_low_kmh) : g->hopf_model_low_kmh;
-    s->warn_from_kmh = fmin(a->prior_hopf_low_kmh - c->warn_speed_margin_kmh,
-                            warn_below_point(g->hopf_model_kmh, lo_e, c->warn_speed_margin_kmh, z,
+      warn_below_point(from, precise ? s->hopf_low_kmh : from, c->warn_speed_margin_kmh, z, c->warn_standard_errors);
+  if (iv->estimate_with_prior)
+    s->warn_from_kmh = fmin(iv->prior_hopf_low_kmh - c->warn_speed_margin_kmh,
+                            warn_below_point(iv->estimate_hopf_kmh, iv->estimate_low_kmh, c->warn_speed_margin_kmh, z,
                                              c->warn_standard_errors));
-  }
   s->watch_from_kmh = from - hypot(h, c->watch_speed_margin_kmh);
-  s->warn_risk = ev->precise && h > 0.0 ? 0.5 * erfc((from - s->warn_from_kmh) / (h / z) / sqrt(2.0)) : NAN;
+  s->warn_risk = precise && h > 0.0 ? 0.5 * erfc((from - s->warn_from_kmh) / (h / z) / sqrt(2.0)) : NAN;
   /* (the cap makes it larger than one standard error's 0.159 where the error exceeds the cap) */
 }
 
-/* The conicity in use, the Hopf interval and the boundaries at the current speed; the table's status on failure. */
-static hm_status assess(hm_alarm a, const hm_estimate *e, const hm_margin_estimate *g, hm_assessment *s) {
-  const hm_alarm_config *c = &a->cfg;
-  /* a bogie's or car's model holds the frame: a frame sensor shows one of its modes (issue #28) */
-  const hm_evidence_config ec = {
-      c->use_conicity_estimate, c->conicity_max_se, c->conicity_fallback, c->conicity_prior_low,
-      a->prior_hopf_low_kmh, a->prior_hopf_high_kmh, a->fallback_hopf_kmh,
-      a->point == HM_POINT_WHEELSET || (a->model && hm_mode_model_kind(a->model) != HM_MODEL_WHEELSET)};
-  hm_evidence_interval ev;
-  hm_evidence_weigh(&a->ev, &ec, g, s->time_s, &ev);
-  const double lambda = ev.conicity, lambda_opt = ev.conicity_opt;
-  double lo = ev.low_kmh, hi = ev.high_kmh;
-  s->conicity_from_estimate = ev.precise;
-  s->conicity_from_prior = ev.from_prior;
-  s->model_interval_used = ev.usable;
-  s->conicity_se = ev.conicity_se;
-  s->model_mismatch = ev.mismatch;
-  s->hopf_free_used = ev.free_counts;
-  s->conicity = lambda;
-  hm_table_lookup_result b, bo;
-  hm_status st = lookup(a, 0, lambda, e->speed_kmh, &b);
-  if (st != HM_OK) return st;
-  s->conicity_outside_table = b.conicity == lambda ? 0 : lambda > b.conicity ? 1 : -1;
-  if (!ev.precise) { /* the table's value at the point is inside the interval it is shown with */
-    lo = fmin(lo, b.hopf_speed_kmh - b.error_speed_kmh);
-    hi = fmax(hi, b.hopf_speed_kmh + b.error_speed_kmh);
-  }
-  s->hopf_low_kmh = fmin(lo, b.hopf_speed_kmh);
-  s->hopf_high_kmh = fmax(hi, b.hopf_speed_kmh);
-  s->boundaries = b;
-  speed_thresholds(a, g, &ev, s);
-  /* the edge: at the conicity in use where the origin is stable there; inside the Hopf interval above the point
-   * estimate, at the interval's optimistic end (found by the lookup at the conicity whose Hopf speed is hopf_high,
-   * which the table's affine 1/V^2 makes exact) */
-  s->edge_used_m = b.has_edge ? b.edge_amp_m : 0.0;
-  if (!b.origin_stable && e->speed_kmh <= s->hopf_high_kmh) {
-    st = lookup(a, 1, lambda_opt, e->speed_kmh, &bo);
-    if (st != HM_OK) return st;
-    s->edge_used_m = bo.origin_stable && bo.has_edge ? bo.edge_amp_m : 0.0;
-  }
-  a->ev.precise = ev.precise;
-  return HM_OK;
+/* The interval's numbers into the assessment. */
+static void take_interval(const hm_hopf_interval *iv, hm_assessment *s) {
+  s->conicity = iv->conicity;
+  s->conicity_se = iv->conicity_se;
+  s->conicity_from_estimate = iv->conicity_from_estimate;
+  s->conicity_from_prior = iv->conicity_from_prior;
+  s->model_interval_used = iv->model_interval_used;
+  s->model_mismatch = iv->model_mismatch;
+  s->hopf_free_used = iv->hopf_free_used;
+  s->narrow_peak_ambiguous = iv->narrow_peak_ambiguous;
+  s->conicity_outside_table = iv->conicity_outside_table;
+  s->boundaries = iv->boundaries;
+  s->hopf_low_kmh = iv->hopf_low_kmh;
+  s->hopf_high_kmh = iv->hopf_high_kmh;
+  s->edge_used_m = iv->edge_used_m;
 }
 
 /* WARN and WATCH from at most basis_kmh less their margins (the published fields agree, alarm.h); warn_risk is not
@@ -660,12 +521,11 @@ static void follow_trend(hm_alarm a, double now, double v_kmh) {
 
 /* With current data: the boundaries and margins into s, the level wanted into *target with its reason; *released
  * when the latch let go. The assessment's status on failure. */
-static hm_status target_with_data(hm_alarm a, const hm_estimate *e, const hm_margin_estimate *g, double now,
-                                  hm_assessment *s, hm_level *target, hm_reason *reason, int *released) {
-  const hm_status st = assess(a, e, g, s);
-  if (st != HM_OK) return st;
+static void target_with_data(hm_alarm a, const hm_estimate *e, const hm_hopf_interval *iv, double now,
+                             hm_assessment *s, hm_level *target, hm_reason *reason, int *released) {
+  take_interval(iv, s);
+  speed_thresholds(a, iv, s);
   s->boundaries_valid = 1;
-  s->narrow_peak_ambiguous = g && g->ambiguous_at_s > 0.0 && now - g->ambiguous_at_s <= HM_ALARM_NARROW_HOLD_S;
   s->margin_hopf_kmh = s->boundaries.hopf_speed_kmh - e->speed_kmh;
   s->margin_lowest_cycle_kmh = s->boundaries.lowest_cycle_speed_kmh - e->speed_kmh;
   s->amplitude_m = e->oscillation_valid ? e->amplitude_displacement_m : 0.0;
@@ -675,7 +535,7 @@ static hm_status target_with_data(hm_alarm a, const hm_estimate *e, const hm_mar
   /* (an identified interval only: the prior's range is already the cautious end of the wheels' wear) */
   const double accel_kmh_s = sustained_acceleration(a, now, e->speed_kmh);
   s->anticipation_kmh = s->conicity_from_estimate ? accel_kmh_s * HM_ALARM_RAISE_LOOKAHEAD_S : 0.0;
-  *target = raw_level(a, e, g, s, a->level, reason);
+  *target = raw_level(a, e, iv, s, a->level, reason);
   int kept = 0;
   if (*target < a->level && a->dvdt_kmh_s > 0.0) {
     /* a lower level only if it would still hold at the speed the present acceleration reaches in
@@ -683,10 +543,9 @@ static hm_status target_with_data(hm_alarm a, const hm_estimate *e, const hm_mar
     hm_estimate ahead = *e;
     ahead.speed_kmh += a->dvdt_kmh_s * HM_ALARM_LOWER_LOOKAHEAD_S;
     hm_reason r_ahead;
-    if (raw_level(a, &ahead, g, s, a->level, &r_ahead) >= a->level) *target = a->level, *reason = a->reason, kept = 1;
+    if (raw_level(a, &ahead, iv, s, a->level, &r_ahead) >= a->level) *target = a->level, *reason = a->reason, kept = 1;
   }
   *released = latch(a, e, now, s, target, reason, kept);
-  return HM_OK;
 }
 
 /* The level moves to target: at once when higher, to NO_DATA or from it, or released; lower only after its
@@ -716,8 +575,11 @@ static void move_level(hm_alarm a, double now, hm_level target, hm_reason reason
   }
 }
 
-hm_status hm_alarm_update(hm_alarm a, const hm_estimate *e, const hm_margin_estimate *g, double now, hm_assessment *out) {
+hm_status hm_alarm_update(hm_alarm a, const hm_estimate *e, const hm_hopf_interval *iv, double now,
+                          hm_assessment *out) {
   if (!a || !e || !out || !isfinite(now)) return HM_EINVAL;
+  const int data = e->accel_valid && e->speed_valid;
+  if (data && !iv) return HM_EINVAL;
   hm_assessment s;
   memset(&s, 0, sizeof s);
   s.time_s = now;
@@ -726,12 +588,8 @@ hm_status hm_alarm_update(hm_alarm a, const hm_estimate *e, const hm_margin_esti
   hm_reason reason = HM_REASON_STARTUP;
   hm_level target = HM_LEVEL_NO_DATA;
   int released = 0;
-  if (!e->accel_valid || !e->speed_valid) {
-    target = target_without_data(a, e, &s, &reason);
-  } else {
-    const hm_status st = target_with_data(a, e, g, now, &s, &target, &reason, &released);
-    if (st != HM_OK) return st;
-  }
+  if (!data) target = target_without_data(a, e, &s, &reason);
+  else target_with_data(a, e, iv, now, &s, &target, &reason, &released);
   hold_numbers(a, now, &s);
   /* (with no data the latch is kept: nothing says the oscillation has gone) */
   move_level(a, now, target, reason, released, &s);
@@ -755,9 +613,6 @@ void hm_alarm_take_snapshot(const hm_alarm a, double now, hm_alarm_snapshot *out
                      (a->latched || isnan(a->hunted_mem_s) || now - a->hunted_mem_s <= a->memory_s);
   s.hunted_at_kmh = counts ? a->hunted_at_kmh : INFINITY;
   s.hunted_age_s = counts && !isnan(a->hunted_mem_s) ? fmax(now - a->hunted_mem_s, 0.0) : counts ? NAN : 0.0;
-  s.precise = a->ev.precise;
-  s.se_ok = a->ev.se_ok;
-  s.precise_lost = a->ev.precise_lost;
   *out = s;
 }
 
@@ -772,9 +627,6 @@ hm_status hm_alarm_snapshot_validate(const hm_alarm_snapshot *s, char *why, size
   else if (s->hunted_at_kmh != INFINITY && !isnan(s->hunted_age_s) &&
            !(isfinite(s->hunted_age_s) && s->hunted_age_s >= 0.0))
     field = "hunted_age_s: finite and >= 0, or NAN";
-  else if (s->precise != 0 && s->precise != 1) field = "precise: 0 or 1";
-  else if (s->se_ok != 0 && s->se_ok != 1) field = "se_ok: 0 or 1";
-  else if (s->precise_lost != 0 && s->precise_lost != 1) field = "precise_lost: 0 or 1";
   if (!field) return HM_OK;
   if (why && len) snprintf(why, len, "alarm: %s", field);
   return HM_EDOMAIN;
@@ -793,8 +645,5 @@ hm_status hm_alarm_restore(hm_alarm a, double now, const hm_alarm_snapshot *s, c
   a->hunted_at_kmh = s->hunted_at_kmh;
   a->hunted_t_s = a->hunted_mem_s =
       s->hunted_at_kmh < INFINITY && !isnan(s->hunted_age_s) ? now - s->hunted_age_s : NAN;
-  a->ev.precise = s->precise;
-  a->ev.se_ok = s->se_ok;
-  a->ev.precise_lost = s->precise_lost; /* (precise_since NAN: the wait counts from the first update) */
   return HM_OK;
 }

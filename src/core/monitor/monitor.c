@@ -24,6 +24,7 @@ struct hm_monitor_s {
   hm_estimator est;
   hm_modal modal;
   hm_margin margin;
+  hm_interval interval;          /* the Hopf interval and boundaries the alarm decides on (interval.h) */
   hm_alarm alarm;
   hm_track_lines lines;          /* the track's lines seen at steady speeds (track_lines.h) */
   int modal_ok;                  /* the identification can run at the current rate */
@@ -97,11 +98,11 @@ static void chunk_clear(speed_chunk *k) {
   k->sum = k->n = k->duration_s = 0.0;
 }
 
-/* The alarm's prior (resolved for the vehicle) is the margin's too: it judges narrow peaks and reports estimates
+/* The interval's prior (resolved for the vehicle) is the margin's too: it judges narrow peaks and reports estimates
  * outside it. */
 static void share_prior(hm_monitor m) {
   double lo = 0.0, hi = 0.0;
-  hm_alarm_prior(m->alarm, &lo, &hi);
+  hm_interval_prior(m->interval, &lo, &hi);
   hm_margin_set_prior(m->margin, lo, hi);
 }
 
@@ -180,7 +181,10 @@ hm_status hm_monitor_create_model(const hm_monitor_config *cfg, hm_model_kind ki
   if (st == HM_OK) st = hm_estimator_create(&cfg->estimator, &m->est, why, len);
   if (st == HM_OK) st = hm_modal_create(&cfg->modal, cfg->estimator.sample_rate_hz, &m->modal, why, len);
   if (st == HM_OK) st = hm_margin_create(&cfg->margin, veh, &m->margin, why, len);
-  if (st == HM_OK) st = hm_alarm_create(&cfg->alarm, veh, table, &m->alarm, why, len);
+  hm_interval_config icfg;
+  hm_alarm_interval_config(&cfg->alarm, &icfg);
+  if (st == HM_OK) st = hm_interval_create(&icfg, veh, table, &m->interval, why, len);
+  if (st == HM_OK) st = hm_alarm_create(&cfg->alarm, &m->alarm, why, len);
   if (st == HM_OK && model) {
     st = hm_mode_model_set_band(model, cfg->modal.band_low_hz, cfg->modal.band_high_hz);
     /* the identified mode is compared with what the same reading gives on the model at the sensor (mode_model.h) */
@@ -198,7 +202,7 @@ hm_status hm_monitor_create_model(const hm_monitor_config *cfg, hm_model_kind ki
     if (st == HM_OK && cfg->estimator.measurement_point == HM_POINT_BOGIE_FRAME)
       hm_estimator_set_displacement_map(m->est, wheelset_displacement, m);
     hm_margin_set_model(m->margin, model);
-    if (st == HM_OK) st = hm_alarm_set_model(m->alarm, model);
+    if (st == HM_OK) st = hm_interval_set_model(m->interval, model);
   }
   if (st == HM_OK) st = hm_track_lines_init(&m->lines, &cfg->track_lines, why, len);
   if (st != HM_OK) {
@@ -206,7 +210,7 @@ hm_status hm_monitor_create_model(const hm_monitor_config *cfg, hm_model_kind ki
     return st;
   }
   hm_alarm_set_displacement_limit(m->alarm, cfg->estimator.displacement_limit_m);
-  hm_alarm_set_measurement_point(m->alarm, cfg->estimator.measurement_point);
+  hm_interval_set_measurement_point(m->interval, cfg->estimator.measurement_point);
   hm_alarm_set_memory(m->alarm, cfg->margin.memory_s);
   share_prior(m);
   m->modal_ok = 1;
@@ -224,6 +228,7 @@ hm_status hm_monitor_create_model(const hm_monitor_config *cfg, hm_model_kind ki
 void hm_monitor_destroy(hm_monitor m) {
   if (!m) return;
   hm_alarm_destroy(m->alarm);
+  hm_interval_destroy(m->interval);
   hm_margin_destroy(m->margin);
   hm_modal_destroy(m->modal);
   hm_estimator_destroy(m->est);
@@ -255,6 +260,7 @@ void hm_monitor_reset(hm_monitor m) {
   hm_track_lines_clear(&m->lines);
   m->large_at = -INFINITY;
   hm_alarm_restart(m->alarm); /* a held ALARM stays held: a latch carries no times that matter */
+  hm_interval_restart(m->interval);
 }
 
 void hm_monitor_time_jump(hm_monitor m, double delta_s) {
@@ -268,6 +274,7 @@ void hm_monitor_time_jump(hm_monitor m, double delta_s) {
   hm_track_lines_shift_time(&m->lines, delta_s);
   m->large_at += delta_s;
   hm_alarm_shift_time(m->alarm, delta_s);
+  hm_interval_shift_time(m->interval, delta_s);
 }
 
 /* The mean speed of the newer half of the last window_s seconds over the older half's (the chunks'); 0 if unknown. */
@@ -494,7 +501,11 @@ hm_status hm_monitor_update(hm_monitor m, double now, hm_monitor_status *out) {
   if (s.estimate.rms_exceeded || s.estimate.peaks_exceeded || s.estimate.displacement_exceeded)
     m->large_at = s.estimate.time_s;
   hm_margin_read(m->margin, now, &s.margin);
-  const hm_status st = hm_alarm_update(m->alarm, &s.estimate, &s.margin, now, &s.assessment);
+  /* the interval with current data only (as the alarm judges: without, no margins are current) */
+  hm_hopf_interval iv;
+  const int data = s.estimate.accel_valid && s.estimate.speed_valid;
+  hm_status st = data ? hm_interval_update(m->interval, s.estimate.speed_kmh, &s.margin, now, &iv) : HM_OK;
+  if (st == HM_OK) st = hm_alarm_update(m->alarm, &s.estimate, data ? &iv : NULL, now, &s.assessment);
   if (st != HM_OK) return st;
   if (s.assessment.level != HM_LEVEL_NO_DATA && isfinite(s.assessment.conicity))
     m->conicity_in_use = s.assessment.conicity;
@@ -524,7 +535,10 @@ hm_status hm_monitor_set_runtime_settings(hm_monitor m, const hm_monitor_config 
   if (st != HM_OK) return st;
   /* both parts were validated above, so neither setter can fail half-way */
   if ((st = hm_estimator_set_limits(m->est, &c.estimator, why, len)) != HM_OK) return st;
-  if ((st = hm_alarm_set_config(m->alarm, &c.alarm, &m->veh, why, len)) != HM_OK) return st;
+  hm_interval_config icfg;
+  hm_alarm_interval_config(&c.alarm, &icfg);
+  if ((st = hm_interval_set_config(m->interval, &icfg, &m->veh, why, len)) != HM_OK) return st;
+  if ((st = hm_alarm_set_config(m->alarm, &c.alarm, why, len)) != HM_OK) return st;
   hm_alarm_set_displacement_limit(m->alarm, c.estimator.displacement_limit_m);
   m->cfg = c;
   share_prior(m);
@@ -563,7 +577,7 @@ hm_status hm_monitor_replace_table(hm_monitor m, hm_table table, hm_table *repla
     hm_table_destroy(table);
     return st;
   }
-  hm_alarm_set_table(m->alarm, table);
+  hm_interval_set_table(m->interval, table);
   if (replaced) *replaced = m->table;
   else hm_table_destroy(m->table);
   m->table = table;
@@ -593,6 +607,7 @@ void hm_monitor_take_snapshot(const hm_monitor m, double now_s, hm_monitor_snaps
   hm_monitor_snapshot s;
   hm_margin_take_snapshot(m->margin, now_s, &s.margin);
   hm_alarm_take_snapshot(m->alarm, now_s, &s.alarm);
+  hm_interval_take_snapshot(m->interval, &s.interval);
   *out = s;
 }
 
@@ -600,10 +615,12 @@ hm_status hm_monitor_restore(hm_monitor m, double now_s, const hm_monitor_snapsh
   if (!m || !snap || !isfinite(now_s)) return HM_EINVAL;
   hm_status st = hm_margin_snapshot_validate(&snap->margin, why, len);
   if (st == HM_OK) st = hm_alarm_snapshot_validate(&snap->alarm, why, len);
+  if (st == HM_OK) st = hm_interval_snapshot_validate(&snap->interval, why, len);
   if (st != HM_OK) return st;
   restart_input(m);
   m->large_at = -INFINITY;
   /* both were validated above, so neither can fail half-way */
   if ((st = hm_margin_restore(m->margin, now_s, &snap->margin, why, len)) != HM_OK) return st;
+  if ((st = hm_interval_restore(m->interval, &snap->interval, why, len)) != HM_OK) return st;
   return hm_alarm_restore(m->alarm, now_s, &snap->alarm, why, len);
 }

@@ -191,9 +191,9 @@ hm_status hm_state_save(const hm_monitor m, double now_s, double written_unix_s,
   put_u32(&w, (uint32_t)a->latch_reason);
   put_f64(&w, a->hunted_at_kmh);
   put_f64(&w, a->hunted_age_s);
-  put_u32(&w, (uint32_t)a->precise);
-  put_u32(&w, (uint32_t)a->se_ok);
-  put_u32(&w, (uint32_t)a->precise_lost);
+  put_u32(&w, (uint32_t)s.interval.precise);
+  put_u32(&w, (uint32_t)s.interval.se_ok);
+  put_u32(&w, (uint32_t)s.interval.precise_lost);
   put_u32(&w, hm_state_checksum(buf, w.at));
   *len = w.at;
   return HM_OK;
@@ -235,10 +235,11 @@ static int read_payload(reader *r, hm_monitor_snapshot *s) {
   a->hunted_at_kmh = get_f64(r);
   a->hunted_age_s = get_f64(r);
   const uint32_t precise = get_u32(r);
-  a->precise = precise <= 1 ? (int)precise : 2;
+  hm_interval_snapshot *iv = &s->interval;
+  iv->precise = precise <= 1 ? (int)precise : 2;
   const uint32_t se_ok = get_u32(r), lost = get_u32(r);
-  a->se_ok = se_ok <= 1 ? (int)se_ok : 2;
-  a->precise_lost = lost <= 1 ? (int)lost : 2;
+  iv->se_ok = se_ok <= 1 ? (int)se_ok : 2;
+  iv->precise_lost = lost <= 1 ? (int)lost : 2;
   if (n_changes != (uint64_t)g->n_changes) return 0;
   return !r->short_read && r->at + 4 == r->len; /* the checksum follows */
 }
