@@ -168,7 +168,8 @@ typedef struct {
   double conicity_max_se;               /* the estimate is used when its standard error is at most this */
   double conicity_fallback;             /* lambda(0) used otherwise; 0: the vehicle's own lambda(0) */
   double conicity_prior_low;            /* the range the wheels may have worn to before identification: it must */
-  double conicity_prior_high;           /* hold the fallback; 0: the fallback -+ HM_ALARM_PRIOR_HALFWIDTH */
+  double conicity_prior_high;           /* hold the fallback (checked for the vehicle by hm_interval_create);
+                                           0: the fallback -+ HM_ALARM_PRIOR_HALFWIDTH */
   double release_s;                     /* an oscillation ALARM is released after this long calm [s] */
   double release_amplitude_fraction;    /* calm: displacement below this fraction of the displacement limit */
   double blind_fraction;                /* WATCH "partly blind" above this fraction of samples lost over 10 s */

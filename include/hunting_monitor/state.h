@@ -21,7 +21,7 @@
  * that give the windows their meaning (hm_state_hash; for a bogie's or car's monitor also its model's parameters and
  * the sensor's point, whose reading the windows are); its age on the clock the caller names (below 0: written after
  * now, another time line; memory_s or more: too old, the margin would have forgotten every window); every field in
- * its range (hm_margin_snapshot_validate, hm_alarm_snapshot_validate). The restored windows are aged by the record's
+ * its range (hm_margin_snapshot_validate, hm_alarm_snapshot_validate, hm_interval_snapshot_validate). The restored windows are aged by the record's
  * age, and those beyond memory_s are forgotten as usual.
  *
  * The age: the writer supplies both its time line's now (the sensor's stamps, a recording's t_s) and the wall clock

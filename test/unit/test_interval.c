@@ -3,7 +3,8 @@
  * closed form the interval uses); the table's value at the conicity in use within its stated error of the same; a
  * precise estimate's interval its own ends; a conicity beyond the table's the exact critical speed and said; the edge
  * inside the interval the table's at the optimistic end; a frame sensor on the wheelset's model kept on the prior;
- * bad settings, input and snapshots refused with the output untouched. */
+ * bad settings, input and snapshots refused with the output untouched; the lookups follow the speed and the table, a
+ * failed one forgets nothing, a held flag keeps its age across a shift of the time line. */
 #include <math.h>
 #include <string.h>
 
@@ -168,6 +169,68 @@ static void refusals_and_the_snapshot(void) {
   hm_interval_destroy(other);
 }
 
+/* The lookups follow the speed and a new table (no stale cache); a prior narrower than the table's error is widened
+ * to the table's value -+ its error; a failed lookup leaves the output and the flags' memory as they were; a shift of
+ * the time line keeps a held flag's age. */
+static void cache_widening_failure_and_time(void) {
+  hm_interval iv = make(0.1358 - 1e-5, 0.1358 + 1e-5);
+  hm_hopf_interval h;
+  hm_table_lookup_result r;
+  HM_CHECK(hm_interval_update(iv, 300.0, NULL, 0.0, &h) == HM_OK && hm_interval_update(iv, 400.0, NULL, 1.0, &h) ==
+               HM_OK && hm_table_lookup(table, 0.1358, 400.0, &r) == HM_OK && h.edge_used_m == r.edge_amp_m,
+           "the edge at 400 km/h after 300: %.6f against %.6f", h.edge_used_m, r.edge_amp_m);
+  HM_CHECK_DELTA(h.hopf_low_kmh, r.hopf_speed_kmh - r.error_speed_kmh, 1e-9, "narrow prior: the table's value less its error");
+  HM_CHECK_DELTA(h.hopf_high_kmh, r.hopf_speed_kmh + r.error_speed_kmh, 1e-9, "narrow prior: plus its error");
+  HM_CHECK(r.error_speed_kmh > 0.05, "the table's error %.3f km/h exceeds the prior's width", r.error_speed_kmh);
+  hm_table other = NULL;
+  hm_table_spec spec;
+  hm_table_spec_default(&spec);
+  spec.conicity_min = 0.10, spec.conicity_max = 0.20, spec.n_conicity = 3;
+  HM_CHECK(hm_table_build(&vehicle, &spec, &other) == HM_OK, "a second table");
+  hm_interval_set_table(iv, other);
+  hm_table_lookup_result r2;
+  HM_CHECK(hm_interval_update(iv, 400.0, NULL, 2.0, &h) == HM_OK && hm_table_lookup(other, 0.1358, 400.0, &r2) == HM_OK &&
+               h.boundaries.error_speed_kmh == r2.error_speed_kmh && r2.error_speed_kmh != r.error_speed_kmh,
+           "the new table's: error %.4f against %.4f (old %.4f)", h.boundaries.error_speed_kmh, r2.error_speed_kmh,
+           r.error_speed_kmh);
+  hm_interval_set_table(iv, table);
+  hm_table_destroy(other);
+  hm_interval_destroy(iv);
+  /* a failed lookup (a speed the table cannot look up) after a precise estimate: nothing written, nothing forgotten */
+  iv = make(0.0, 0.0);
+  const hm_margin_estimate g = identified(0.16);
+  HM_CHECK(hm_interval_update(iv, 450.0, &g, 0.0, &h) == HM_OK && h.conicity_from_estimate, "alone");
+  hm_interval_snapshot before, after;
+  hm_interval_take_snapshot(iv, &before);
+  hm_hopf_interval h0 = h;
+  hm_margin_estimate worse = g;
+  worse.conicity_se = 0.02; /* (would drop the estimate's use, were it weighed) */
+  HM_CHECK(hm_interval_update(iv, NAN, &worse, 1.0, &h) != HM_OK && memcmp(&h, &h0, sizeof h) == 0,
+           "a failed lookup: refused, nothing written");
+  hm_interval_take_snapshot(iv, &after);
+  HM_CHECK(memcmp(&before, &after, sizeof before) == 0, "a failed lookup: the flags' memory kept");
+  hm_interval_destroy(iv);
+  /* model_mismatch held for HM_ALARM_FLAG_CLEAR_S (20 s) after it clears, across a shift of the time line */
+  for (int shift = 0; shift < 2; ++shift) {
+    iv = make(0.0, 0.0);
+    hm_margin_estimate mm = g;
+    mm.model_mismatch = 1;
+    hm_interval_update(iv, 450.0, &mm, 0.0, &h);
+    mm.model_mismatch = 0;
+    hm_interval_update(iv, 450.0, &mm, 5.0, &h); /* false from 5 s: held until 25 s */
+    if (shift) hm_interval_shift_time(iv, 100.0);
+    hm_interval_update(iv, 450.0, &mm, 20.0 + 100.0 * shift, &h);
+    HM_CHECK(h.model_mismatch, "shift %d: held 15 s after it cleared", shift);
+    hm_interval_update(iv, 450.0, &mm, 26.0 + 100.0 * shift, &h);
+    HM_CHECK(!h.model_mismatch, "shift %d: cleared 21 s after", shift);
+    hm_interval_destroy(iv);
+  }
+  hm_interval_snapshot bad = {1, 1, 3};
+  char why[120] = "";
+  HM_CHECK(hm_interval_snapshot_validate(&bad, why, sizeof why) == HM_EDOMAIN && strstr(why, "precise_lost"), "%s",
+           why);
+}
+
 int main(void) {
   hm_vehicle_default(&vehicle);
   if (hm_test_small_table(&table) != HM_OK) {
@@ -178,6 +241,7 @@ int main(void) {
   HM_RUN(a_precise_estimate_and_the_sensor);
   HM_RUN(beyond_the_table_and_the_edge);
   HM_RUN(refusals_and_the_snapshot);
+  HM_RUN(cache_widening_failure_and_time);
   hm_table_destroy(table);
   HM_TEST_EXIT();
 }

@@ -152,11 +152,16 @@ hm_status hm_alarm_config_validate(const hm_alarm_config *c, char *why, size_t l
       {"watch_speed_margin_kmh", c->watch_speed_margin_kmh, HM_RULE_RANGE, 0.0, 500.0},
       {"hysteresis_kmh", c->hysteresis_kmh, HM_RULE_RANGE, 0.0, 100.0},
       {"hysteresis_amplitude_fraction", c->hysteresis_amplitude_fraction, HM_RULE_RANGE, 0.0, 1.0},
-      {"min_hold_s", c->min_hold_s, HM_RULE_RANGE, 0.0, 3600.0},
+      {"min_hold_s", c->min_hold_s, HM_RULE_RANGE, 0.0, 3600.0}};
+  const hm_field_check after[] = { /* (the interval's fields are checked between, in the settings' order) */
       {"blind_fraction", c->blind_fraction, HM_RULE_RANGE_OPEN, 0.0, 1.0},
       {"release_s", c->release_s, HM_RULE_RANGE, 0.0, 3600.0},
       {"release_amplitude_fraction", c->release_amplitude_fraction, HM_RULE_RANGE_OPEN, 0.0, 1.0}};
-  const hm_status st = hm_check_fields(f, HM_COUNT_OF(f), why, len);
+  hm_interval_config ic;
+  hm_alarm_interval_config(c, &ic);
+  hm_status st = hm_check_fields(f, HM_COUNT_OF(f), why, len);
+  if (st == HM_OK) st = hm_interval_config_validate(&ic, why, len);
+  if (st == HM_OK) st = hm_check_fields(after, HM_COUNT_OF(after), why, len);
   if (st != HM_OK) return st;
   if (!(c->watch_speed_margin_kmh >= c->warn_speed_margin_kmh))
     return hm_reject(why, len, "watch_speed_margin_kmh", "must be at least warn_speed_margin_kmh",
@@ -164,9 +169,7 @@ hm_status hm_alarm_config_validate(const hm_alarm_config *c, char *why, size_t l
   if (!(c->hysteresis_amplitude_fraction < c->warn_amplitude_fraction))
     return hm_reject(why, len, "hysteresis_amplitude_fraction", "must be below warn_amplitude_fraction",
                      c->hysteresis_amplitude_fraction);
-  hm_interval_config ic;
-  hm_alarm_interval_config(c, &ic);
-  return hm_interval_config_validate(&ic, why, len);
+  return HM_OK;
 }
 
 void hm_alarm_interval_config(const hm_alarm_config *c, hm_interval_config *out) {

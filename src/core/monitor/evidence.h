@@ -1,8 +1,9 @@
 /* Private to the core: the Hopf interval the evidence gives (alarm.h states the rules). Which of the margin's
  * estimates count this update, each flag held against its chatter (a flag raised at once and cleared only after its
  * condition has been false for HM_ALARM_FLAG_CLEAR_S; the estimate used alone again only after its condition held that
- * long), and the interval they and the prior give. The alarm decides levels from it and holds one hm_evidence for the
- * flags' memory (saved in its snapshot); nothing here looks up a table or decides a level. */
+ * long), and the interval they and the prior give. The interval module (interval.h) holds one hm_evidence for the
+ * flags' memory (saved in its snapshot) and adds the table's boundaries; nothing here looks up a table or decides a
+ * level. */
 #ifndef HM_CORE_EVIDENCE_H
 #define HM_CORE_EVIDENCE_H
 

@@ -117,10 +117,17 @@ void hm_interval_set_table(hm_interval iv, const hm_table table) {
 
 hm_status hm_interval_set_model(hm_interval iv, hm_mode_model model) {
   if (!iv) return HM_EINVAL;
+  hm_interval_config c;
+  double lo, hi, at_fallback; /* the prior's Hopf speeds from the model */
+  const hm_status st = resolve(&iv->cfg, &iv->veh, model, &c, &lo, &hi, &at_fallback, NULL, 0);
+  if (st != HM_OK) return st;
   iv->model = model;
-  const hm_interval_config cfg = iv->cfg;
-  const hm_vehicle veh = iv->veh;
-  return hm_interval_set_config(iv, &cfg, &veh, NULL, 0); /* the prior's Hopf speeds from the model */
+  iv->cfg = c;
+  iv->prior_hopf_low_kmh = lo;
+  iv->prior_hopf_high_kmh = hi;
+  iv->fallback_hopf_kmh = at_fallback;
+  iv->cache[0].valid = iv->cache[1].valid = 0; /* the Hopf curve changed */
+  return HM_OK;
 }
 
 void hm_interval_set_measurement_point(hm_interval iv, hm_measurement_point point) {

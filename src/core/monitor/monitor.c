@@ -533,11 +533,12 @@ hm_status hm_monitor_set_runtime_settings(hm_monitor m, const hm_monitor_config 
   c.estimator.displacement_limit_m = cfg->estimator.displacement_limit_m;
   hm_status st = hm_monitor_config_validate(&c, why, len);
   if (st != HM_OK) return st;
-  /* both parts were validated above, so neither setter can fail half-way */
-  if ((st = hm_estimator_set_limits(m->est, &c.estimator, why, len)) != HM_OK) return st;
+  /* the interval first: it alone can still refuse (a prior that does not hold the vehicle's fallback), and then
+   * nothing has changed; the other parts were validated above, so they cannot fail half-way */
   hm_interval_config icfg;
   hm_alarm_interval_config(&c.alarm, &icfg);
   if ((st = hm_interval_set_config(m->interval, &icfg, &m->veh, why, len)) != HM_OK) return st;
+  if ((st = hm_estimator_set_limits(m->est, &c.estimator, why, len)) != HM_OK) return st;
   if ((st = hm_alarm_set_config(m->alarm, &c.alarm, why, len)) != HM_OK) return st;
   hm_alarm_set_displacement_limit(m->alarm, c.estimator.displacement_limit_m);
   m->cfg = c;

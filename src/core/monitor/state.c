@@ -223,7 +223,7 @@ static int read_payload(reader *r, hm_monitor_snapshot *s) {
   g->n_changes = (unsigned long)n_changes;
   g->last_change_age_s = get_f64(r);
   g->windows_since_change = get_u32(r);
-  /* an enumeration or flag out of range is kept out of range (validated by the margin and the alarm) */
+  /* an enumeration or flag out of range is kept out of range (validated by the margin, the alarm and the interval) */
   const uint32_t narrow = get_u32(r);
   g->narrow = (hm_narrow_verdict)(narrow <= HM_NARROW_AMBIGUOUS ? narrow : HM_NARROW_AMBIGUOUS + 1);
   g->narrow_peak_hz = get_f64(r);
