@@ -87,6 +87,9 @@ extern "C" {
 #endif
 
 #define HM_MARGIN_MAX_WINDOWS 64
+/* Readings whose windows start within this of each other [s] are of one stretch (read again as it grows): where one
+ * chose one pole pair and the other two, their conicities' difference is an error of the window's. */
+#define HM_MARGIN_SAME_STRETCH_S 0.5
 /* A window whose decay rate is within this of zero [1/s] is near evidence (the alarm lets an estimate outside the
  * prior, or a change's first window, set the interval only with it): 50 km/h below the default vehicle's Hopf speed
  * the decay rate is -1.5..-2.5 1/s, 200 km/h below it -7..-25, where a bogie that is not the wheelset model read, by
@@ -195,7 +198,7 @@ hm_status hm_margin_create(const hm_margin_config *cfg, const hm_vehicle *veh, h
                            size_t why_len);
 void hm_margin_destroy(hm_margin m);
 void hm_margin_reset(hm_margin m);
-/* The range of conicities the wheels may have worn to (the alarm's prior, alarm.h): a narrow peak's conicity is
+/* The range of conicities the wheels may have worn to (the interval's prior, interval.h): a narrow peak's conicity is
  * supported by it when no window is held, and an estimate outside it is reported (outside_prior). Invalid values
  * (non-finite, not 0 < low < high) remove it. */
 void hm_margin_set_prior(hm_margin m, double conicity_low, double conicity_high);
@@ -211,7 +214,11 @@ hm_status hm_margin_add_window(hm_margin m, double t_end_s, double speed_kmh, do
 
 /* The current steady stretch as a provisional window: checked like a window, counted by hm_margin_read, replaced by
  * the next call, stored by hm_margin_commit_pending (when the stretch ends) and dropped by hm_margin_add_window. A
- * stretch thus contributes while it lasts, and once as one long window (not as overlapping or short pieces). */
+ * stretch thus contributes while it lasts, and once as one long window (not as overlapping or short pieces). Read
+ * again at every fit, a stretch's reading may choose one pole pair at one fit and two at the next (modal.h: a mode
+ * beside a broader resonance): once the stretch has been read both ways, each window of it (provisional, or a full
+ * one offered by hm_margin_add_window) carries the difference of the two decompositions' latest conicities as a
+ * systematic error (HM_MARGIN_SAME_STRETCH_S tells a stretch), so that the interval does not follow the flip. */
 hm_status hm_margin_set_pending(hm_margin m, double t_end_s, double speed_kmh, double speed_spread_kmh,
                                 const hm_mode_estimate *mode, hm_window_verdict *verdict);
 void hm_margin_commit_pending(hm_margin m);

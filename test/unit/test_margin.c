@@ -181,6 +181,54 @@ static void pending_window_of_a_stretch(void) {
   hm_margin_destroy(m);
 }
 
+/* A stretch read one way at one fit and the other at the next (issue #26: one pole pair, then two): the second
+ * window's conicity error is its own in quadrature with the two readings' difference (margin.h), each against a
+ * margin that saw that reading alone; a stretch read one way only carries none. */
+static void a_stretch_read_both_ways(void) {
+  hm_margin_config c;
+  hm_margin_config_default(&c);
+  hm_mode_estimate one = mode_at(0.16, 440.0, 0.3, 0.05), two = mode_at(0.15, 440.0, 0.3, 0.05);
+  one.poles = 1, two.poles = 2;
+  one.window_s = 20.0, two.window_s = 21.0; /* both from 0 s: one stretch, read at 20 and 21 s */
+  hm_margin_estimate alone_one, alone_two, g;
+  hm_window_verdict v;
+  hm_margin m = NULL, fresh = NULL;
+  for (int k = 0; k < 2; ++k) { /* each reading alone */
+    hm_margin_create(&c, &vehicle, &m, NULL, 0);
+    hm_margin_set_pending(m, k ? 21.0 : 20.0, 440.0, 1.0, k ? &two : &one, &v);
+    hm_margin_read(m, 21.0, k ? &alone_two : &alone_one);
+    hm_margin_destroy(m);
+  }
+  hm_margin_create(&c, &vehicle, &m, NULL, 0);
+  hm_margin_set_pending(m, 20.0, 440.0, 1.0, &one, &v);
+  hm_margin_set_pending(m, 21.0, 440.0, 1.0, &two, &v);
+  hm_margin_read(m, 21.0, &g);
+  const double d = alone_two.conicity - alone_one.conicity;
+  printf("  one pair %.4f +- %.4f, two %.4f +- %.4f; the second read after the first: %.4f +- %.4f\n",
+         alone_one.conicity, alone_one.conicity_se, alone_two.conicity, alone_two.conicity_se, g.conicity, g.conicity_se);
+  HM_CHECK(v == HM_WINDOW_USED && fabs(d + 0.01) < 1e-4, "readings 0.01 apart: %g", d);
+  HM_CHECK_DELTA(g.conicity, alone_two.conicity, 1e-12, "its own conicity");
+  HM_CHECK_DELTA(g.conicity_se, hypot(alone_two.conicity_se, d), 1e-12, "its error with the difference");
+  two.window_s = 22.0; /* read both ways before: the difference to the other way's latest stays */
+  hm_margin_estimate alone_22;
+  hm_margin_create(&c, &vehicle, &fresh, NULL, 0);
+  hm_margin_set_pending(fresh, 22.0, 440.0, 1.0, &two, &v);
+  hm_margin_read(fresh, 22.0, &alone_22);
+  hm_margin_destroy(fresh);
+  hm_margin_set_pending(m, 22.0, 440.0, 1.0, &two, &v);
+  hm_margin_read(m, 22.0, &g);
+  HM_CHECK_DELTA(g.conicity_se, hypot(alone_22.conicity_se, alone_22.conicity - alone_one.conicity), 1e-12,
+                 "the stretch read both ways");
+  hm_margin_destroy(m);
+  hm_margin_create(&c, &vehicle, &m, NULL, 0);
+  hm_margin_set_pending(m, 20.0, 440.0, 1.0, &two, &v);
+  two.window_s = 21.0;
+  hm_margin_set_pending(m, 21.0, 440.0, 1.0, &two, &v);
+  hm_margin_read(m, 21.0, &g);
+  HM_CHECK_DELTA(g.conicity_se, alone_two.conicity_se, 1e-12, "read one way twice: its own error");
+  hm_margin_destroy(m);
+}
+
 /* A change of the conicity (issue #18): three windows of lambda 0.12 (Hopf 553.8 km/h) at 420-455 km/h, then one of
  * lambda 0.16 (473.8 km/h) at 460: far beyond 4 combined standard errors, so the windows held are dropped and the new
  * one is kept (the evidence of the change, issue #27: 0.16 at once, windows_since_change 1), the change counted; the
@@ -502,6 +550,7 @@ int main(void) {
   HM_RUN(both_ways_agree_on_a_consistent_vehicle);
   HM_RUN(refusals_and_mismatch);
   HM_RUN(pending_window_of_a_stretch);
+  HM_RUN(a_stretch_read_both_ways);
   HM_RUN(changes_misfits_and_disagreement);
   HM_TEST_EXIT();
 }

@@ -39,6 +39,12 @@ struct hm_margin_s {
   double prior_low, prior_high; /* the conicities the wheels may have worn to (hm_margin_set_prior); 0, 0: none */
   hm_narrow_verdict narrow;     /* what the latest window's narrow peak was taken for */
   double narrow_hz, narrow_at_s, ambiguous_at_s;
+  /* the last used reading of each decomposition (one pole pair, two: index poles - 1) in the stretch that starts at
+   * its start_s (a stretch's provisional window is read again at every fit, monitor.h; across_fits) */
+  struct {
+    int valid;
+    double start_s, lambda;
+  } last[2];
 };
 
 const char *hm_window_verdict_text(hm_window_verdict v) {
@@ -139,6 +145,8 @@ void hm_margin_shift_time(hm_margin m, double delta_s) {
   for (size_t k = 0; k < m->misfit_n; ++k) m->misfit_t[k] += delta_s;
   m->pending.t_end_s += delta_s;
   m->pending_misfit_t += delta_s;
+  m->last[0].start_s += delta_s;
+  m->last[1].start_s += delta_s;
   m->last_end_s += delta_s;
   if (m->n_changes) m->last_change_s += delta_s;
   if (m->narrow_at_s != 0.0) m->narrow_at_s += delta_s;
@@ -166,6 +174,7 @@ void hm_margin_reset(hm_margin m) {
   m->pending_misfit = 0;
   m->n_changes = 0;
   m->last_change_s = 0.0;
+  m->last[0].valid = m->last[1].valid = 0;
 }
 
 double hm_margin_hopf_kmh(const hm_margin m, double conicity) {
@@ -403,6 +412,25 @@ static hm_window_verdict prepare(const hm_margin m, double t_end, double speed_k
   return *narrow = HM_NARROW_AMBIGUOUS, HM_WINDOW_AMBIGUOUS;
 }
 
+/* The stretch's readings from fit to fit (margin.h, issue #26): a stretch at one speed is read again at every fit
+ * while it grows, and the likelihood may choose one pole pair at one fit and two at the next (a mode beside a broader
+ * resonance: a bogie's axle box read 0.145 +- 0.009 with one pair and 0.115 +- 0.011 with two, a second apart, and the
+ * one pair's reading gave a WARN 64 km/h below the truth). Where the stretch has been read in the other decomposition,
+ * the difference of the two conicities is an error of the window's (systematic: the same data read two ways); a
+ * used reading is remembered for its decomposition. */
+static void across_fits(hm_margin m, hm_window_verdict v, window *w) {
+  if (v != HM_WINDOW_USED || (w->poles != 1 && w->poles != 2)) return;
+  const double start = w->t_end_s - w->window_s;
+  const int k = (int)w->poles - 1, other = 1 - k;
+  if (m->last[other].valid && fabs(m->last[other].start_s - start) <= HM_MARGIN_SAME_STRETCH_S) {
+    w->lambda_sys = hypot(w->lambda_sys, w->lambda - m->last[other].lambda);
+    w->lambda_se = hypot(w->lambda_stat, w->lambda_sys);
+  }
+  m->last[k].valid = 1;
+  m->last[k].start_s = start;
+  m->last[k].lambda = w->lambda;
+}
+
 /* Keep a window (the ring drops the oldest beyond its size); any provisional one is superseded. */
 static void store(hm_margin m, const window *w) {
   m->w[m->head] = *w;
@@ -464,6 +492,7 @@ hm_status hm_margin_add_window(hm_margin m, double t_end, double speed_kmh, doub
   window w;
   hm_narrow_verdict narrow;
   *verdict = prepare(m, t_end, speed_kmh, spread_kmh, mode, &w, &narrow);
+  across_fits(m, *verdict, &w);
   note_narrow(m, t_end, mode, narrow);
   m->pending_misfit = 0; /* a committed window ends the stretch's provisional one */
   if (*verdict == HM_WINDOW_MISFIT) misfit_push(m, t_end);
@@ -479,6 +508,7 @@ hm_status hm_margin_set_pending(hm_margin m, double t_end, double speed_kmh, dou
   window w;
   hm_narrow_verdict narrow;
   *verdict = prepare(m, t_end, speed_kmh, spread_kmh, mode, &w, &narrow);
+  across_fits(m, *verdict, &w);
   note_narrow(m, t_end, mode, narrow);
   m->pending_misfit = *verdict == HM_WINDOW_MISFIT;
   m->pending_misfit_t = t_end;
