@@ -522,8 +522,8 @@ static void follow_trend(hm_alarm a, double now, double v_kmh) {
   a->t_prev_s = now;
 }
 
-/* With current data: the boundaries and margins into s, the level wanted into *target with its reason; *released
- * when the latch let go. The assessment's status on failure. */
+/* With current data: the interval's boundaries and the margins into s, the level wanted into *target with its reason;
+ * *released when the latch let go. */
 static void target_with_data(hm_alarm a, const hm_estimate *e, const hm_hopf_interval *iv, double now,
                              hm_assessment *s, hm_level *target, hm_reason *reason, int *released) {
   take_interval(iv, s);

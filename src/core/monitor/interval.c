@@ -93,20 +93,28 @@ hm_status hm_interval_create(const hm_interval_config *cfg, const hm_vehicle *ve
 
 void hm_interval_destroy(hm_interval iv) { free(iv); }
 
-hm_status hm_interval_set_config(hm_interval iv, const hm_interval_config *cfg, const hm_vehicle *veh, char *why,
-                                 size_t why_len) {
-  if (!iv || !cfg || !veh) return HM_EINVAL;
+/* Settings, vehicle and model taken together once the prior resolves for them (iv untouched otherwise); the cached
+ * lookups dropped: the conicity in use and the Hopf curve may change with any of them. */
+static hm_status apply(hm_interval iv, const hm_interval_config *cfg, const hm_vehicle *veh, hm_mode_model model,
+                       char *why, size_t why_len) {
   hm_interval_config c;
   double lo, hi, at_fallback;
-  const hm_status st = resolve(cfg, veh, iv->model, &c, &lo, &hi, &at_fallback, why, why_len);
+  const hm_status st = resolve(cfg, veh, model, &c, &lo, &hi, &at_fallback, why, why_len);
   if (st != HM_OK) return st;
   iv->cfg = c;
   iv->veh = *veh;
+  iv->model = model;
   iv->prior_hopf_low_kmh = lo;
   iv->prior_hopf_high_kmh = hi;
   iv->fallback_hopf_kmh = at_fallback;
-  iv->cache[0].valid = iv->cache[1].valid = 0; /* the conicity in use may change with the settings */
+  iv->cache[0].valid = iv->cache[1].valid = 0;
   return HM_OK;
+}
+
+hm_status hm_interval_set_config(hm_interval iv, const hm_interval_config *cfg, const hm_vehicle *veh, char *why,
+                                 size_t why_len) {
+  if (!iv || !cfg || !veh) return HM_EINVAL;
+  return apply(iv, cfg, veh, iv->model, why, why_len);
 }
 
 void hm_interval_set_table(hm_interval iv, const hm_table table) {
@@ -117,17 +125,9 @@ void hm_interval_set_table(hm_interval iv, const hm_table table) {
 
 hm_status hm_interval_set_model(hm_interval iv, hm_mode_model model) {
   if (!iv) return HM_EINVAL;
-  hm_interval_config c;
-  double lo, hi, at_fallback; /* the prior's Hopf speeds from the model */
-  const hm_status st = resolve(&iv->cfg, &iv->veh, model, &c, &lo, &hi, &at_fallback, NULL, 0);
-  if (st != HM_OK) return st;
-  iv->model = model;
-  iv->cfg = c;
-  iv->prior_hopf_low_kmh = lo;
-  iv->prior_hopf_high_kmh = hi;
-  iv->fallback_hopf_kmh = at_fallback;
-  iv->cache[0].valid = iv->cache[1].valid = 0; /* the Hopf curve changed */
-  return HM_OK;
+  const hm_interval_config cfg = iv->cfg; /* (a copy: apply writes iv->cfg) */
+  const hm_vehicle veh = iv->veh;
+  return apply(iv, &cfg, &veh, model, NULL, 0); /* the prior's Hopf speeds from the model */
 }
 
 void hm_interval_set_measurement_point(hm_interval iv, hm_measurement_point point) {

@@ -620,7 +620,7 @@ hm_status hm_monitor_restore(hm_monitor m, double now_s, const hm_monitor_snapsh
   if (st != HM_OK) return st;
   restart_input(m);
   m->large_at = -INFINITY;
-  /* both were validated above, so neither can fail half-way */
+  /* all three were validated above, so none can fail half-way */
   if ((st = hm_margin_restore(m->margin, now_s, &snap->margin, why, len)) != HM_OK) return st;
   if ((st = hm_interval_restore(m->interval, &snap->interval, why, len)) != HM_OK) return st;
   return hm_alarm_restore(m->alarm, now_s, &snap->alarm, why, len);
