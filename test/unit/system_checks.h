@@ -1,11 +1,12 @@
 /* The tests' own checks of any model (system.h), used by test_bogie_model.c, test_car.c and test_system_cycles.c:
  * classic RK4 of the right-hand side (nothing of the core's integrators or shooting), the growth rate of the linear
- * motion it gives, and the analytic Jacobian against central differences. Include after hm_test.h. */
+ * motion it gives (and the critical speed against it), and the analytic Jacobian against central differences. Include after hm_test.h. */
 #ifndef HM_TEST_SYSTEM_CHECKS_H
 #define HM_TEST_SYSTEM_CHECKS_H
 
 #include <string.h>
 
+#include "hunting_monitor/linear.h"
 #include "hunting_monitor/system.h"
 
 /* One RK4 step of h from x (dim states) at speed v [m/s]. */
@@ -58,6 +59,22 @@ static inline double system_growth_rate(const hm_system *sys, double v, double s
     }
   }
   return 0.5 * (nb * sxy - sx * sy) / (nb * sxx - sx * sx); /* |x|^2 grows at twice the rate */
+}
+
+/* The critical speed by eigenvalues (hm_system_critical_speed's defaults) against the simulation's growth rate 0.1 km/h
+ * either side (stable below, unstable above); the speed [m/s] and the spectrum there into *vc and *s. */
+static inline void check_critical_against_simulation(const hm_system *sys, double *vc, hm_system_spectrum *s) {
+  hm_system_critical_options opt;
+  hm_system_critical_options_default(&opt);
+  *vc = 0.0;
+  HM_CHECK(hm_system_critical_speed(sys, &opt, vc, s) == HM_OK, "critical");
+  printf("  critical %.4f km/h at %.4f Hz, the mode's energy %.3f / %.3f / %.3f in wheelsets / frames / carbody\n",
+         hm_kmh_from_mps(*vc), s->frequency_hz, s->body_share[0], sys->n_bodies > 1 ? s->body_share[1] : 0.0,
+         sys->n_bodies > 2 ? s->body_share[2] : 0.0);
+  const double below = system_growth_rate(sys, *vc - hm_mps_from_kmh(0.1), 60.0, 240.0);
+  const double above = system_growth_rate(sys, *vc + hm_mps_from_kmh(0.1), 60.0, 240.0);
+  printf("  simulated growth rates 0.1 km/h below and above: %.6f, %.6f 1/s\n", below, above);
+  HM_CHECK(below < 0.0 && above > 0.0, "the simulation's stability changes within 0.1 km/h of the critical speed");
 }
 
 /* The analytic Jacobian at (v, x) against central differences of the right-hand side (relative 1e-6, absolute 1e-3

@@ -82,17 +82,10 @@ static void critical_speed_against_simulation(void) {
     hm_bogie_model m;
     hm_system sys;
     default_bogie(lambdas[k], 0, &b, &m, &sys);
-    hm_system_critical_options opt;
-    hm_system_critical_options_default(&opt);
     double vc = 0.0;
     hm_system_spectrum s;
-    HM_CHECK(hm_system_critical_speed(&sys, &opt, &vc, &s) == HM_OK, "critical");
-    printf("  conicity %.4f: critical %.4f km/h at %.3f Hz, the mode's energy %.2f in the wheelsets, %.2f in the "
-           "frame\n", lambdas[k], hm_kmh_from_mps(vc), s.frequency_hz, s.body_share[0], s.body_share[1]);
-    const double below = system_growth_rate(&sys, vc - hm_mps_from_kmh(0.1), 60.0, 240.0);
-    const double above = system_growth_rate(&sys, vc + hm_mps_from_kmh(0.1), 60.0, 240.0);
-    printf("  simulated growth rates 0.1 km/h below and above: %.5f, %.5f 1/s\n", below, above);
-    HM_CHECK(below < 0.0 && above > 0.0, "the simulation's stability changes within 0.1 km/h of the critical speed");
+    printf("  conicity %.4f:\n", lambdas[k]);
+    check_critical_against_simulation(&sys, &vc, &s);
     for (int side = -1; side <= 1; side += 2) {
       const double v = vc + side * hm_mps_from_kmh(15.0);
       hm_system_spectrum e;
