@@ -955,12 +955,12 @@ def test_independent_sim_sample_rates():
         close(got[fs]["frequency_hz"], got[2000]["frequency_hz"], 0.01 * got[2000]["frequency_hz"], f"frequency at {fs} Hz")
 
 
-def bogie_matrix(v, lam, kx=8.96e6, ky=8.96e6):
+def bogie_matrix(v, lam, kx=8.96e6, ky=8.96e6, ratio=1.351186, ksy=2.5e5, csy=3e4):
     """The linearised bogie of bogie.h written again here from its header's equations (the defaults of
-    config/bogie_default.yaml): the 13 x 13 matrix at speed v [m/s] and conicity lam."""
+    config/bogie_default.yaml, the carbody fixed): the 13 x 13 matrix at speed v [m/s] and conicity lam."""
     import numpy as np
-    m, I, d0, d1, r0, f, ratio = 1869.0, 910.0, 0.7465, 1.0, 0.43, 7.99e6, 1.351186
-    mf, jf, b, ksy, csy, ka, da, cd, kd, dd = 2600.0, 1800.0, 1.25, 2.5e5, 3e4, 1.5e5, 1.0, 1e6, 5e7, 1.3
+    m, I, d0, d1, r0, f = 1869.0, 910.0, 0.7465, 1.0, 0.43, 7.99e6
+    mf, jf, b, ka, da, cd, kd, dd = 2600.0, 1800.0, 1.25, 1.5e5, 1.0, 1e6, 5e7, 1.3
     kg = kx * (ratio - 1.0)
     n = 13
     # the equations as forces: M x'' = ... ; row by row, states y1 y1' p1 p1' y2 y2' p2 p2' yf yf' pf pf' u
@@ -995,28 +995,65 @@ def bogie_matrix(v, lam, kx=8.96e6, ky=8.96e6):
     return A
 
 
+def car_matrix(v, lam, ratio=1.351186, ksy=2.5e5, csy=3e4, mc=35000.0, ic=1.8e6, a=8.75):
+    """The linearised car of car.h from its header's equations: two bogies (bogie_matrix, their secondary acting on
+    the frame's motion relative to the carbody at x_j = +-a) and the carbody (mc yc'' = sum F_j, Ic psic'' = sum x_j
+    F_j + M_j); the 30 x 30 matrix at speed v [m/s] and conicity lam (config/car_default.yaml's values by default)."""
+    import numpy as np
+    mf, jf, ka, da, cd, kd, dd = 2600.0, 1800.0, 1.5e5, 1.0, 1e6, 5e7, 1.3
+    kyaw = 2 * ka * da ** 2 + 2 * dd ** 2 * kd  # the air springs' and yaw dampers' yaw stiffness on psif - psic
+    A = np.zeros((30, 30))
+    Y, YD, P, PD = 26, 27, 28, 29
+    A[Y, YD] = A[P, PD] = 1.0
+    for j, x in enumerate((a, -a)):
+        o = 13 * j
+        A[o:o + 13, o:o + 13] = bogie_matrix(v, lam, ratio=ratio, ksy=ksy, csy=csy)
+        yf, yfd, pf, u = o + 8, o + 9, o + 10, o + 12
+        # the frame: its secondary forces on yf - yc - x psic and psif - psic
+        A[yfd, [Y, YD, P, PD]] += np.array([ksy, csy, ksy * x, csy * x]) / mf
+        A[o + 11, P] += kyaw / jf
+        A[u, P] -= kd * dd / cd
+        # the carbody: F_j = ksy (yf - yc - x psic) + csy (yf' - yc' - x psic'), M_j = 2 ka da^2 (psif - psic)
+        # + 2 dd kd (dd (psif - psic) - u)
+        F = np.zeros(30)
+        F[[yf, yfd, Y, YD, P, PD]] = [ksy, csy, -ksy, -csy, -ksy * x, -csy * x]
+        M = np.zeros(30)
+        M[[pf, P, u]] = [kyaw, -kyaw, -2 * dd * kd]
+        A[YD] += F / mc
+        A[PD] += (x * F + M) / ic
+    return A
+
+
+def bisect_critical(matrix, v0_kmh=100.0, step_kmh=5.0):
+    """The first speed [km/h] above v0 (up to 1500) where matrix(v [m/s])'s largest real part turns positive (steps,
+    then 50 halvings), and the frequency [Hz] of that eigenvalue."""
+    import numpy as np
+
+    def abscissa(v_kmh):
+        e = np.linalg.eigvals(matrix(v_kmh / 3.6))
+        k = int(np.argmax(e.real))
+        return e[k].real, abs(e[k].imag) / (2 * math.pi)
+
+    lo, hi = v0_kmh, v0_kmh
+    while abscissa(hi)[0] < 0:
+        lo, hi = hi, hi + step_kmh
+        assert hi <= 1500.0, "no critical speed in 100-1500 km/h"
+    for _ in range(50):
+        mid = 0.5 * (lo + hi)
+        lo, hi = (mid, hi) if abscissa(mid)[0] < 0 else (lo, mid)
+    return hi, abscissa(hi)[1]
+
 def test_bogie_critical_and_eig():
     """`hunting critical` and `eig` on config/bogie_default.yaml against a second implementation (numpy's eigvals of
     bogie_matrix, bisected here), and the frame held against MODEL.md's 517.618 km/h."""
     import numpy as np
     cfg = os.path.join(SRC, "config", "bogie_default.yaml")
-
-    def abscissa(v_kmh, lam):
-        e = np.linalg.eigvals(bogie_matrix(v_kmh / 3.6, lam))
-        k = int(np.argmax(e.real))
-        return e[k].real, abs(e[k].imag) / (2 * math.pi)
-
     for lam in (0.1358, 0.2, 0.3):
         out = run_json("critical", "--config", cfg, "--conicity", str(lam))
         assert out["model"] == "bogie", out
-        lo, hi = 100.0, 100.0
-        while abscissa(hi, lam)[0] < 0:
-            lo, hi = hi, hi + 5.0
-        for _ in range(50):
-            mid = 0.5 * (lo + hi)
-            lo, hi = (mid, hi) if abscissa(mid, lam)[0] < 0 else (lo, mid)
-        close(out["v_crit_kmh"], hi, 1e-4, f"bogie critical speed at {lam}")
-        close(out["frequency_hz"], abscissa(hi, lam)[1], 1e-4, f"bogie critical frequency at {lam}")
+        v_ref, f_ref = bisect_critical(lambda v: bogie_matrix(v, lam))
+        close(out["v_crit_kmh"], v_ref, 1e-4, f"bogie critical speed at {lam}")
+        close(out["frequency_hz"], f_ref, 1e-4, f"bogie critical frequency at {lam}")
         shares = out["mode_energy_share"]
         close(shares["wheelsets"] + shares["bogie frame"], 1.0, 1e-12, "energy shares")
         assert out["mode"] == max(shares, key=shares.get), out
@@ -1063,7 +1100,8 @@ def test_bogie_cycles():
 
 def test_car_critical_and_cycles():
     """The whole vehicle (config/car_default.yaml): with its carbody held its critical speed is the bogie's; the
-    origin's stability flips within 0.01 km/h of its own (eig); its family starts there."""
+    origin's stability flips within 0.01 km/h of its own (eig); its family starts there; its critical speed and that
+    of config/car_carbody_hunting.yaml's carbody at conicity 0.01 and 0.02 against car_matrix's, bisected here."""
     car = os.path.join(SRC, "config", "car_default.yaml")
     bogie = os.path.join(SRC, "config", "bogie_default.yaml")
     out = run_json("critical", "--config", car)
@@ -1076,6 +1114,18 @@ def test_car_critical_and_cycles():
     fam = run_json("cycles", "--config", car, "--v-min", "450", "--v-max", "700", "--amp-max", "0.004")
     assert fam["model"] == "car", fam["model"]
     close(fam["hopf"]["v_kmh"], out["v_crit_kmh"], 1e-6, "the car family's Hopf speed")
+    v_ref, f_ref = bisect_critical(lambda v: car_matrix(v, 0.1358))
+    close(out["v_crit_kmh"], v_ref, 1e-4, "the car's critical speed against car_matrix")
+    close(out["frequency_hz"], f_ref, 1e-4, "the car's critical frequency against car_matrix")
+    # carbody hunting (config/car_carbody_hunting.yaml): at low conicity the carbody's mode goes first
+    hunt = os.path.join(SRC, "config", "car_carbody_hunting.yaml")
+    for lam in (0.01, 0.02):
+        got = run_json("critical", "--config", hunt, "--conicity", str(lam))
+        v_ref, f_ref = bisect_critical(lambda v: car_matrix(v, lam, ratio=1.0, ksy=4e5, csy=1e4, mc=30000.0,
+                                                            ic=2.5e6))
+        close(got["v_crit_kmh"], v_ref, 1e-4, f"carbody hunting's critical speed at {lam}")
+        close(got["frequency_hz"], f_ref, 1e-4, f"carbody hunting's frequency at {lam}")
+        assert got["mode"] == "carbody" and got["mode_energy_share"]["carbody"] > 0.9, got["mode_energy_share"]
 
 
 def test_bogie_and_car_simulate():
