@@ -290,6 +290,10 @@ typedef struct {
   unsigned hold_waits;              /* what the release waits for: HM_HOLD_WAITS_* bits */
   hm_reason hold_no_data;           /* with HM_HOLD_WAITS_DATA, what is missing (HM_REASON_NO_ACCEL, NO_SPEED or
                                        BAD_SAMPLE_RATE: the level NO_DATA would have said); else HM_REASON_STARTUP */
+  hm_speed_refusal speed_refused;   /* with no current speed (NO_DATA or a hold waiting for data): why the speeds that
+                                       arrive are refused (estimator.h; HM_SPEED_ACCEPTED: none arrive); the reason's
+                                       text says it, e.g. "no current speed (speeds arrive, refused: above
+                                       max_speed_kmh)" */
   double hunted_at_s;               /* when the oscillation met a criterion at hunted_at_kmh (after a restore: when its
                                        memory started, state.h; NAN: none) */
   double time_s;                    /* the update's time [s] */

@@ -66,6 +66,18 @@
 extern "C" {
 #endif
 
+/* Why a speed was refused (hm_estimator_push_speed). */
+typedef enum {
+  HM_SPEED_ACCEPTED = 0,
+  HM_SPEED_NOT_FINITE = 1,   /* non-finite or negative */
+  HM_SPEED_ABOVE_MAX = 2,    /* above max_speed_kmh */
+  HM_SPEED_IMPLAUSIBLE = 3,  /* changed by more than max_speed_rate_kmh_s x dt + max_speed_jump_kmh */
+  HM_SPEED_NOT_AFTER = 4     /* its stamp not after the previous accepted one's */
+} hm_speed_refusal;
+
+/* "above max_speed_kmh" and so on; "" for HM_SPEED_ACCEPTED. */
+const char *hm_speed_refusal_text(hm_speed_refusal r);
+
 /* Upper bounds of the settings that size the estimator's buffers: at 5 kHz the r.m.s. ring then holds at most
  * 5000 x 1000 m / (30 km/h) = 600,000 samples (9.6 MB), the crossing ring 20 x 2 x band_high_hz crossings. */
 #define HM_ESTIMATOR_MAX_TRACKING_S 20.0
@@ -120,6 +132,8 @@ typedef struct {
   int accel_valid;                /* samples arrived within accel_timeout_s of `now` */
   int speed_valid;                /* a plausible speed arrived within speed_timeout_s of `now` */
   double speed_kmh;               /* last accepted speed (0 if none) */
+  hm_speed_refusal speed_refused; /* with speed_valid 0: why the latest speed was refused (HM_SPEED_ACCEPTED if it was
+                                     not, or none came) */
   int oscillation_valid;          /* tracker settled: a full tracking time of samples and a frequency */
   double amplitude_accel_mps2;
   double frequency_hz;            /* 0 if not valid */

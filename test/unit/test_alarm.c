@@ -203,7 +203,18 @@ static void stale_input_is_no_data(void) {
   update(a, &e, NULL, 0.1, &s);
   HM_CHECK(s.level == HM_LEVEL_NO_DATA && s.reason == HM_REASON_NO_SPEED && !s.boundaries_valid && s.changed,
            "stale speed: %s", hm_level_name(s.level));
+  /* speeds that arrive and are refused (a train at 601 km/h with max_speed_kmh 600) are told apart from none */
+  char said[160];
+  hm_assessment_reason_text(&s, 0.0, said, sizeof said);
+  HM_CHECK(strcmp(said, "no current speed") == 0, "none arrive: '%s'", said);
+  e.speed_refused = HM_SPEED_ABOVE_MAX;
+  update(a, &e, NULL, 0.15, &s);
+  hm_assessment_reason_text(&s, 0.0, said, sizeof said);
+  HM_CHECK(s.level == HM_LEVEL_NO_DATA &&
+               strcmp(said, "no current speed (speeds arrive, refused: above max_speed_kmh)") == 0, "refused: '%s'",
+           said);
   e.speed_valid = 1;
+  e.speed_refused = HM_SPEED_ACCEPTED;
   e.accel_valid = 0;
   update(a, &e, NULL, 0.2, &s);
   HM_CHECK(s.level == HM_LEVEL_NO_DATA && s.reason == HM_REASON_NO_ACCEL, "stale acceleration");

@@ -390,11 +390,19 @@ static void bad_input_is_skipped(void) {
   HM_CHECK(hm_estimator_push_speed(e, t, -5.0) == HM_EDOMAIN, "negative speed");
   HM_CHECK(hm_estimator_push_speed(e, t + 0.01, NAN) == HM_EDOMAIN, "NaN speed");
   HM_CHECK(hm_estimator_push_speed(e, t + 0.02, 480.0) == HM_EDOMAIN, "80 km/h jump in 20 ms");
+  /* why the latest speed was refused, told once the accepted one is stale (1 s after it) */
+  hm_estimator_read(e, t + 1.2, &est);
+  HM_CHECK(!est.speed_valid && est.speed_refused == HM_SPEED_IMPLAUSIBLE, "refused as a jump: %d", est.speed_refused);
+  HM_CHECK(hm_estimator_push_speed(e, t - 0.5, 400.0) == HM_EDOMAIN, "a speed stamped before the last one");
+  hm_estimator_read(e, t + 1.2, &est);
+  HM_CHECK(est.speed_refused == HM_SPEED_NOT_AFTER, "refused for its stamp: %d", est.speed_refused);
   HM_CHECK(hm_estimator_push_speed(e, t + 0.03, 700.0) == HM_EDOMAIN, "above max speed");
   hm_estimator_read(e, t, &est);
+  HM_CHECK(est.speed_valid && est.speed_refused == HM_SPEED_ACCEPTED, "a current speed: no refusal told (%d)",
+           est.speed_refused);
   HM_CHECK(all_finite(&est), "non-finite output after bad input");
   HM_CHECK(est.n_rejected_nonfinite == 3 && est.n_rejected_range == 1 && est.n_rejected_order == 2 &&
-               est.n_speed_rejected == 4,
+               est.n_speed_rejected == 5,
            "counters %lu %lu %lu %lu", est.n_rejected_nonfinite, est.n_rejected_range, est.n_rejected_order,
            est.n_speed_rejected);
   HM_CHECK(est.oscillation_valid && fabs(est.frequency_hz - 10.0) < 0.05 && est.speed_kmh == 400.0,
@@ -403,7 +411,8 @@ static void bad_input_is_skipped(void) {
   hm_estimator_read(e, t + 0.3, &est);
   HM_CHECK(!est.accel_valid && est.speed_valid, "acceleration stale after 0.3 s");
   hm_estimator_read(e, t + 1.5, &est);
-  HM_CHECK(!est.speed_valid, "speed stale after 1.5 s");
+  HM_CHECK(!est.speed_valid && est.speed_refused == HM_SPEED_ABOVE_MAX, "speed stale after 1.5 s, the latest refused "
+           "as above max_speed_kmh (%d: %s)", est.speed_refused, hm_speed_refusal_text(est.speed_refused));
   /* a 0.5 s gap restarts the trackers, which settle again */
   const double t2 = t + 0.5;
   for (long i = 0; i < 6000; ++i) {

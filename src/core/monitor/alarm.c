@@ -85,6 +85,11 @@ static void append_when(char *buf, size_t len, size_t *n, double t_s, double now
   else append(buf, len, n, " at %.1f s", t_s - origin_s);
 }
 
+/* Why the speeds that arrive are refused, after "no current speed". */
+static void append_refusal(char *buf, size_t len, size_t *n, hm_speed_refusal r) {
+  if (r != HM_SPEED_ACCEPTED) append(buf, len, n, " (speeds arrive, refused: %s)", hm_speed_refusal_text(r));
+}
+
 size_t hm_assessment_reason_text(const hm_assessment *s, double origin_s, char *buf, size_t len) {
   size_t n = 0;
   if (buf && len) buf[0] = '\0';
@@ -92,6 +97,7 @@ size_t hm_assessment_reason_text(const hm_assessment *s, double origin_s, char *
   if (!s) return 0;
   if (!s->latched || !s->held) {
     append(buf, len, &n, "%s", hm_reason_text(s->reason));
+    if (s->reason == HM_REASON_NO_SPEED) append_refusal(buf, len, &n, s->speed_refused);
     return n;
   }
   append(buf, len, &n, "held (%s", hm_reason_text(s->hold_cause));
@@ -111,7 +117,9 @@ size_t hm_assessment_reason_text(const hm_assessment *s, double origin_s, char *
   else
     append(buf, len, &n, " releases below the Hopf interval after %.0f s calm", s->calm_needed_s);
   if (s->hold_waits & HM_HOLD_WAITS_DATA) {
-    append(buf, len, &n, " (%s: the calm is seen only with data)", hm_reason_text(s->hold_no_data));
+    append(buf, len, &n, " (%s", hm_reason_text(s->hold_no_data));
+    if (s->hold_no_data == HM_REASON_NO_SPEED) append_refusal(buf, len, &n, s->speed_refused);
+    append(buf, len, &n, ": the calm is seen only with data)");
     return n;
   }
   append(buf, len, &n, " (calm %.1f s", s->calm_s);
@@ -496,6 +504,7 @@ static hm_level target_without_data(hm_alarm a, const hm_estimate *e, hm_assessm
   *reason = !e->sample_rate_supported ? HM_REASON_BAD_SAMPLE_RATE
             : !e->accel_valid         ? HM_REASON_NO_ACCEL
                                       : HM_REASON_NO_SPEED;
+  s->speed_refused = e->speed_valid ? HM_SPEED_ACCEPTED : e->speed_refused;
   a->block_n = a->n_blocks = 0; /* no speed: the acceleration starts again */
   if (!a->latched) return HM_LEVEL_NO_DATA;
   /* a held ALARM outlives its data: nothing says the oscillation has gone (alarm.h) */

@@ -35,6 +35,7 @@ struct hm_estimator_s {
   /* speed */
   int have_speed;
   double speed_kmh, t_speed;
+  hm_speed_refusal speed_refusal; /* the latest speed's (HM_SPEED_ACCEPTED once one is accepted) */
   /* the tracked oscillation as of the last crossing (the crossing ring changes only there) */
   double trk_f, trk_spread, trk_amp;
   hm_estimate counters;          /* only the counters are used */
@@ -291,6 +292,7 @@ void hm_estimator_reset(hm_estimator e) {
   e->have_speed = 0;
   e->speed_kmh = 0.0;
   e->t_speed = 0.0;
+  e->speed_refusal = HM_SPEED_ACCEPTED;
   memset(&e->counters, 0, sizeof e->counters);
 }
 
@@ -425,17 +427,34 @@ hm_status hm_estimator_push_accel(hm_estimator e, double t, double a) {
 
 unsigned hm_estimator_last_fill(const hm_estimator e) { return e ? e->last_fill : 0; }
 
+const char *hm_speed_refusal_text(hm_speed_refusal r) {
+  switch (r) {
+    case HM_SPEED_ACCEPTED: return "";
+    case HM_SPEED_NOT_FINITE: return "not finite or negative";
+    case HM_SPEED_ABOVE_MAX: return "above max_speed_kmh";
+    case HM_SPEED_IMPLAUSIBLE: return "changing faster than max_speed_rate_kmh_s";
+    case HM_SPEED_NOT_AFTER: return "stamped not after the previous one";
+  }
+  return "refused";
+}
+
 hm_status hm_estimator_push_speed(hm_estimator e, double t, double v) {
   if (!e) return HM_EINVAL;
   e->counters.n_speed_updates++;
   const hm_estimator_config *c = &e->cfg;
-  int ok = isfinite(t) && isfinite(v) && v >= 0.0 && v <= c->max_speed_kmh;
-  if (ok && e->have_speed) {
+  hm_speed_refusal why = !(isfinite(t) && isfinite(v) && v >= 0.0) ? HM_SPEED_NOT_FINITE
+                         : v > c->max_speed_kmh                    ? HM_SPEED_ABOVE_MAX
+                                                                   : HM_SPEED_ACCEPTED;
+  if (why == HM_SPEED_ACCEPTED && e->have_speed) {
     const double dt = t - e->t_speed;
     const int fresh = dt <= c->speed_timeout_s;
-    ok = dt > 0.0 && (!fresh || fabs(v - e->speed_kmh) <= c->max_speed_rate_kmh_s * dt + c->max_speed_jump_kmh);
+    if (!(dt > 0.0))
+      why = HM_SPEED_NOT_AFTER;
+    else if (fresh && !(fabs(v - e->speed_kmh) <= c->max_speed_rate_kmh_s * dt + c->max_speed_jump_kmh))
+      why = HM_SPEED_IMPLAUSIBLE;
   }
-  if (!ok) {
+  e->speed_refusal = why;
+  if (why != HM_SPEED_ACCEPTED) {
     e->counters.n_speed_rejected++;
     return HM_EDOMAIN;
   }
@@ -463,6 +482,7 @@ void hm_estimator_read(const hm_estimator e, double now, hm_estimate *out) {
                   r.sample_rate_supported;
   r.speed_valid = e->have_speed && isfinite(now) && now - e->t_speed <= c->speed_timeout_s;
   r.speed_kmh = e->have_speed ? e->speed_kmh : 0.0;
+  r.speed_refused = r.speed_valid ? HM_SPEED_ACCEPTED : e->speed_refusal;
   const double f = e->have_sample ? e->trk_f : 0.0, spread = e->trk_spread, amp = e->trk_amp;
   const int settled = e->have_sample && e->t_last - e->t_start >= c->tracking_time_s;
   r.oscillation_valid = settled && f > 0.0;
