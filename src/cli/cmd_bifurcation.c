@@ -607,25 +607,86 @@ static void write_lpc_point(json_writer *w, const hm_lpc_point *p, const char *p
   jw_end_object(w);
 }
 
+/* lpc-curve's options: the vehicle with --start set on the plane's second parameter, the cycles' and curve's
+ * options; 1 after an error message. */
+static int lpc_setup(const cli_args *a, hm_vehicle *veh, hm_plane *plane, hm_cycle_options *o, hm_lpc_options *lo,
+                     double *start, double *speed) {
+  if (cli_vehicle(a, veh, NULL) || plane_option(a, plane, 0) || cycle_options(a, HM_PARAM_SPEED, o)) return 1;
+  const hm_param p2 = *plane == HM_PLANE_KY_V ? HM_PARAM_KY : HM_PARAM_KX;
+  hm_lpc_options_default(lo, p2);
+  if (cli_number(a, "from", &lo->p2_min) || cli_number(a, "to", &lo->p2_max)) return 1;
+  *start = 0.5 * (lo->p2_min + lo->p2_max);
+  *speed = 500.0;
+  if (cli_number(a, "start", start)) return 1;
+  if (!(lo->p2_max > lo->p2_min) || !(*start >= lo->p2_min && *start <= lo->p2_max)) {
+    fprintf(stderr, "hunting lpc-curve: need --from < --to and --start between them\n");
+    return 1;
+  }
+  if (hm_param_set(veh, speed, p2, *start) != HM_OK) {
+    fprintf(stderr, "hunting lpc-curve: invalid --start %g\n", *start);
+    return 1;
+  }
+  return 0;
+}
+
+/* One curve's object: the fold it started from, its two directions' stops and statistics, its points. */
+static void write_lpc_curve(json_writer *w, const hm_cycle_event *fold, const hm_cont_stats stats[2],
+                            const hm_lpc_point *pts, size_t np, const char *p2name) {
+  jw_object(w, NULL);
+  jw_number(w, "from_fold_v_kmh", fold->point.param);
+  jw_number(w, "from_fold_amplitude_m", fold->point.amp_y_m);
+  jw_array(w, "stop_reasons");
+  jw_string(w, NULL, hm_cont_stop_name(stats[0].stop));
+  jw_string(w, NULL, hm_cont_stop_name(stats[1].stop));
+  jw_end_array(w);
+  jw_array(w, "continuation");
+  write_cont_stats(w, NULL, &stats[0]);
+  write_cont_stats(w, NULL, &stats[1]);
+  jw_end_array(w);
+  jw_array(w, "points");
+  for (size_t k = 0; k < np; ++k) write_lpc_point(w, &pts[k], p2name);
+  jw_end_array(w);
+  jw_end_object(w);
+}
+
+/* The curves from every fold of the family not already on one (all: MAX_LPC points, cusps: 32), then the cusps; the
+ * exit status (0, or 1 after an error message). */
+static int write_lpc_curves(json_writer *w, const hm_vehicle *veh, double speed, const hm_cycle_options *o,
+                            const hm_lpc_options *lo, const family *fam, double start, const char *p2name,
+                            hm_lpc_point *all) {
+  hm_lpc_point cusps[32];
+  size_t used = 0, n_cusps = 0;
+  int rc = 0;
+  jw_array(w, "curves");
+  for (size_t i = 0; i < fam->n_events && rc == 0; ++i) {
+    const hm_cycle_event *fold = &fam->events[i];
+    if (fold->kind != HM_CYCLE_LPC || on_curve(all, used, start, fold)) continue;
+    size_t np = 0, nc = 0;
+    hm_cont_stats stats[2];
+    const hm_status st = hm_lpc_curve(veh, speed, o, lo, fold, all + used, MAX_LPC - used, &np, cusps + n_cusps,
+                                      32 - n_cusps, &nc, stats);
+    if (st != HM_OK) {
+      rc = cli_fail_status("LPC curve", st);
+      break;
+    }
+    write_lpc_curve(w, fold, stats, all + used, np, p2name);
+    used += np;
+    n_cusps += nc;
+  }
+  jw_end_array(w);
+  jw_array(w, "cusps");
+  for (size_t k = 0; k < n_cusps; ++k) write_lpc_point(w, &cusps[k], p2name);
+  jw_end_array(w);
+  return rc;
+}
+
 int cmd_lpc_curve(const cli_args *a) {
   hm_vehicle veh;
   hm_plane plane;
   hm_cycle_options o;
   hm_lpc_options lo;
-  if (cli_vehicle(a, &veh, NULL) || plane_option(a, &plane, 0) || cycle_options(a, HM_PARAM_SPEED, &o)) return 1;
-  const hm_param p2 = plane == HM_PLANE_KY_V ? HM_PARAM_KY : HM_PARAM_KX;
-  hm_lpc_options_default(&lo, p2);
-  if (cli_number(a, "from", &lo.p2_min) || cli_number(a, "to", &lo.p2_max)) return 1;
-  double start = 0.5 * (lo.p2_min + lo.p2_max), speed = 500.0;
-  if (cli_number(a, "start", &start)) return 1;
-  if (!(lo.p2_max > lo.p2_min) || !(start >= lo.p2_min && start <= lo.p2_max)) {
-    fprintf(stderr, "hunting lpc-curve: need --from < --to and --start between them\n");
-    return 1;
-  }
-  if (hm_param_set(&veh, &speed, p2, start) != HM_OK) {
-    fprintf(stderr, "hunting lpc-curve: invalid --start %g\n", start);
-    return 1;
-  }
+  double start, speed;
+  if (lpc_setup(a, &veh, &plane, &o, &lo, &start, &speed)) return 1;
   hm_hopf_point hopf;
   size_t n = 0;
   if (find_hopf(a, &veh, HM_PARAM_SPEED, speed, "v-min", "v-max", &hopf, 1, &n)) return 1;
@@ -635,15 +696,10 @@ int cmd_lpc_curve(const cli_args *a) {
     return 1;
   }
   hm_lpc_point *all = malloc(MAX_LPC * sizeof *all);
-  if (!all) {
-    free(fam.points);
-    return cli_fail_status("lpc-curve", HM_ENOMEM);
-  }
-  const char *p2name = hm_param_name(p2);
   /* the document is built in memory and written only when complete: a failure half-way leaves no broken JSON */
   char *doc = NULL;
   size_t doc_len = 0;
-  FILE *mem = open_memstream(&doc, &doc_len);
+  FILE *mem = all ? open_memstream(&doc, &doc_len) : NULL;
   if (!mem) {
     free(all);
     free(fam.points);
@@ -654,44 +710,8 @@ int cmd_lpc_curve(const cli_args *a) {
   jw_object(&w, NULL);
   jw_string(&w, "plane", plane == HM_PLANE_KY_V ? "ky-v" : "kx-v");
   jw_number(&w, "start", start);
-  jw_array(&w, "curves");
-  size_t used = 0;
-  hm_lpc_point cusps[32];
-  size_t n_cusps_all = 0;
-  int rc = 0;
-  for (size_t i = 0; i < fam.n_events && rc == 0; ++i) {
-    const hm_cycle_event *fold = &fam.events[i];
-    if (fold->kind != HM_CYCLE_LPC || on_curve(all, used, start, fold)) continue;
-    size_t np = 0, nc = 0;
-    hm_cont_stats stats[2];
-    hm_status st = hm_lpc_curve(&veh, speed, &o, &lo, fold, all + used, MAX_LPC - used, &np,
-                                cusps + n_cusps_all, 32 - n_cusps_all, &nc, stats);
-    if (st != HM_OK) {
-      rc = cli_fail_status("LPC curve", st);
-      break;
-    }
-    jw_object(&w, NULL);
-    jw_number(&w, "from_fold_v_kmh", fold->point.param);
-    jw_number(&w, "from_fold_amplitude_m", fold->point.amp_y_m);
-    jw_array(&w, "stop_reasons");
-    jw_string(&w, NULL, hm_cont_stop_name(stats[0].stop));
-    jw_string(&w, NULL, hm_cont_stop_name(stats[1].stop));
-    jw_end_array(&w);
-    jw_array(&w, "continuation");
-    write_cont_stats(&w, NULL, &stats[0]);
-    write_cont_stats(&w, NULL, &stats[1]);
-    jw_end_array(&w);
-    jw_array(&w, "points");
-    for (size_t k = 0; k < np; ++k) write_lpc_point(&w, &all[used + k], p2name);
-    jw_end_array(&w);
-    jw_end_object(&w);
-    used += np;
-    n_cusps_all += nc;
-  }
-  jw_end_array(&w);
-  jw_array(&w, "cusps");
-  for (size_t k = 0; k < n_cusps_all; ++k) write_lpc_point(&w, &cusps[k], p2name);
-  jw_end_array(&w);
+  const hm_param p2 = plane == HM_PLANE_KY_V ? HM_PARAM_KY : HM_PARAM_KX;
+  const int rc = write_lpc_curves(&w, &veh, speed, &o, &lo, &fam, start, hm_param_name(p2), all);
   jw_end_object(&w);
   jw_finish(&w);
   fclose(mem);

@@ -123,6 +123,11 @@ bool MonitorRos::loadParameters() {
     ROS_FATAL("hunting_monitor: %s", err);
     return false;
   }
+  return loadTopicParameters() && loadStateAndClockParameters() && createMonitor();
+}
+
+// The inputs' and outputs' parameters (message types, axis, time source, units, rate), checked.
+bool MonitorRos::loadTopicParameters() {
   pnh_.param<std::string>("accel_type", accel_type_, "imu");
   pnh_.param<std::string>("imu_axis", imu_axis_, "y");
   pnh_.param<std::string>("time_source", time_source_, "header");
@@ -132,27 +137,6 @@ bool MonitorRos::loadParameters() {
   pnh_.param("status_rate_hz", status_rate_hz_, 20.0);
   pnh_.param("bench_table_churn", bench_table_churn_, false);
   pnh_.param("allow_reconfigure", allow_reconfigure_, false);
-  hm_state_config state_cfg;
-  hm_state_config_default(&state_cfg);
-  pnh_.param("state_period_s", state_cfg.period_s, state_cfg.period_s);
-  if (hm_state_config_validate(&state_cfg, err, sizeof err) != HM_OK) {
-    ROS_FATAL("hunting_monitor: ~state_period_s: %s", err);
-    return false;
-  }
-  state_period_s_ = state_cfg.period_s;
-  if (!pnh_.getParam("state_file", state_file_)) state_file_ = defaultStateFile(pnh_.getNamespace());
-  state_restore_pending_ = !state_file_.empty();
-  state_outcome_ = state_file_.empty() ? "off (~state_file empty)" : "waiting for the first sample to restore";
-  hm_clock_config clock_cfg;
-  hm_clock_config_default(&clock_cfg);
-  pnh_.param("clock/window_s", clock_cfg.window_s, clock_cfg.window_s);
-  pnh_.param("clock/max_step_s", clock_cfg.max_step_s, clock_cfg.max_step_s);
-  pnh_.param("clock/confirm_s", clock_cfg.confirm_s, clock_cfg.confirm_s);
-  if (hm_clock_config_validate(&clock_cfg, err, sizeof err) != HM_OK) {
-    ROS_FATAL("hunting_monitor: ~%s", err);
-    return false;
-  }
-  hm_clock_init(&clock_, &clock_cfg);
   if (accel_type_ != "imu" && accel_type_ != "float64") {
     ROS_FATAL("hunting_monitor: ~accel_type must be imu or float64, got '%s'", accel_type_.c_str());
     return false;
@@ -176,7 +160,40 @@ bool MonitorRos::loadParameters() {
     ROS_FATAL("hunting_monitor: ~status_rate_hz must be in (0, 1000], got %g", status_rate_hz_);
     return false;
   }
-  // The start-up policy (table checked against the vehicle or computed for it, fallback conicity) is the core's.
+  return true;
+}
+
+// The state file's and the sensor clock's parameters, validated by the core.
+bool MonitorRos::loadStateAndClockParameters() {
+  char err[512] = "";
+  hm_state_config state_cfg;
+  hm_state_config_default(&state_cfg);
+  pnh_.param("state_period_s", state_cfg.period_s, state_cfg.period_s);
+  if (hm_state_config_validate(&state_cfg, err, sizeof err) != HM_OK) {
+    ROS_FATAL("hunting_monitor: ~state_period_s: %s", err);
+    return false;
+  }
+  state_period_s_ = state_cfg.period_s;
+  if (!pnh_.getParam("state_file", state_file_)) state_file_ = defaultStateFile(pnh_.getNamespace());
+  state_restore_pending_ = !state_file_.empty();
+  state_outcome_ = state_file_.empty() ? "off (~state_file empty)" : "waiting for the first sample to restore";
+  hm_clock_config clock_cfg;
+  hm_clock_config_default(&clock_cfg);
+  pnh_.param("clock/window_s", clock_cfg.window_s, clock_cfg.window_s);
+  pnh_.param("clock/max_step_s", clock_cfg.max_step_s, clock_cfg.max_step_s);
+  pnh_.param("clock/confirm_s", clock_cfg.confirm_s, clock_cfg.confirm_s);
+  if (hm_clock_config_validate(&clock_cfg, err, sizeof err) != HM_OK) {
+    ROS_FATAL("hunting_monitor: ~%s", err);
+    return false;
+  }
+  hm_clock_init(&clock_, &clock_cfg);
+  return true;
+}
+
+// The monitor over its table: ~table_file checked against the vehicle, or computed on start (~table_n); the
+// start-up policy (the table's check, the fallback conicity) is the core's.
+bool MonitorRos::createMonitor() {
+  char err[512] = "";
   hm_table table = nullptr;
   if (table_file_.empty()) {  // computed on start (on every processor: 36 conicities in about 0.55 s)
     int n = static_cast<int>(cfg_.table_n_conicity);

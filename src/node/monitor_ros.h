@@ -36,6 +36,9 @@ class MonitorRos {
 
  private:
   bool loadParameters();
+  bool loadTopicParameters();
+  bool loadStateAndClockParameters();
+  bool createMonitor();
   void onAccelFloat(const std_msgs::Float64::ConstPtr& msg);
   void onAccelImu(const sensor_msgs::Imu::ConstPtr& msg);
   void onSpeed(const std_msgs::Float64::ConstPtr& msg);
