@@ -69,7 +69,7 @@ extern "C" {
 /* Why a speed was refused (hm_estimator_push_speed). */
 typedef enum {
   HM_SPEED_ACCEPTED = 0,
-  HM_SPEED_NOT_FINITE = 1,   /* non-finite or negative */
+  HM_SPEED_NOT_FINITE = 1,   /* non-finite or negative, or its stamp not finite */
   HM_SPEED_ABOVE_MAX = 2,    /* above max_speed_kmh */
   HM_SPEED_IMPLAUSIBLE = 3,  /* changed by more than max_speed_rate_kmh_s x dt + max_speed_jump_kmh */
   HM_SPEED_NOT_AFTER = 4     /* its stamp not after the previous accepted one's */
@@ -132,8 +132,9 @@ typedef struct {
   int accel_valid;                /* samples arrived within accel_timeout_s of `now` */
   int speed_valid;                /* a plausible speed arrived within speed_timeout_s of `now` */
   double speed_kmh;               /* last accepted speed (0 if none) */
-  hm_speed_refusal speed_refused; /* with speed_valid 0: why the latest speed was refused (HM_SPEED_ACCEPTED if it was
-                                     not, or none came) */
+  hm_speed_refusal speed_refused; /* with speed_valid 0: why the latest speed was refused, while its stamp lies within
+                                     speed_timeout_s of `now` (HM_SPEED_ACCEPTED if it was not refused, or none came
+                                     lately: a silent sensor is not one whose speeds are refused) */
   int oscillation_valid;          /* tracker settled: a full tracking time of samples and a frequency */
   double amplitude_accel_mps2;
   double frequency_hz;            /* 0 if not valid */

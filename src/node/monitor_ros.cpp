@@ -410,7 +410,7 @@ void MonitorRos::onTimer(const ros::TimerEvent&) {
   publishLevel(s, m.reason, now);
   if (static_cast<int>(s.level) != last_logged_level_) {
     last_logged_level_ = static_cast<int>(s.level);
-    ROS_INFO("hunting_monitor: level %s (%s) at %.1f km/h", hm_level_name(s.level), hm_reason_text(s.reason),
+    ROS_INFO("hunting_monitor: level %s (%s) at %.1f km/h", hm_level_name(s.level), m.reason.c_str(),
              st.estimate.speed_kmh);
   }
   publishMarkers(st, now);
@@ -663,6 +663,7 @@ void MonitorRos::diagnoseInputs(diagnostic_updater::DiagnosticStatusWrapper& sta
                  !have_last_                ? "no data yet"
                  : !e.sample_rate_supported ? "acceleration at a sample rate the filters cannot use"
                  : !e.accel_valid           ? "acceleration stale or missing"
+                 : e.speed_refused          ? std::string("speeds arrive, refused: ") + hm_speed_refusal_text(e.speed_refused)
                                             : "speed stale or missing");
   else if (ros::WallTime::now().toSec() - last_jump_at_ < 10.0)
     stat.summary(diagnostic_msgs::DiagnosticStatus::WARN, "time jumped: " + last_jump_);

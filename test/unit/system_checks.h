@@ -67,7 +67,9 @@ static inline void check_critical_against_simulation(const hm_system *sys, doubl
   hm_system_critical_options opt;
   hm_system_critical_options_default(&opt);
   *vc = 0.0;
-  HM_CHECK(hm_system_critical_speed(sys, &opt, vc, s) == HM_OK, "critical");
+  const hm_status st = hm_system_critical_speed(sys, &opt, vc, s);
+  HM_CHECK(st == HM_OK, "critical");
+  if (st != HM_OK) return;
   printf("  critical %.4f km/h at %.4f Hz, the mode's energy %.3f / %.3f / %.3f in wheelsets / frames / carbody\n",
          hm_kmh_from_mps(*vc), s->frequency_hz, s->body_share[0], sys->n_bodies > 1 ? s->body_share[1] : 0.0,
          sys->n_bodies > 2 ? s->body_share[2] : 0.0);

@@ -4,8 +4,8 @@
  * both sides of it (the wheelsets' mode of the default car). A carbody mode: without secondary lateral damping at
  * conicity 0.03 the default car's carbody sway on its air springs (the closed form sqrt(2 Ksy / mc) / 2 pi) is the
  * mode that crosses, if only just (its real part moves by about 1e-5 1/s per km/h there: MODEL.md's geometric term
- * ties each wheelset to the track with 3.15 MN/m, and the bogies cannot feed a carbody motion). And carbody hunting:
- * config/car_carbody_hunting.yaml (no such term, a lighter carbody on stiffer air springs) at conicity 0.02, where
+ * ties each wheelset to the track with 3.15 MN/m). And carbody hunting: config/car_carbody_hunting.yaml (no such
+ * term, a lighter carbody on stiffer air springs, a weaker lateral damper) at conicity 0.02, where
  * the carbody's mode crosses at about 195 km/h and 0.76 Hz: the speed against the simulation's growth rate either
  * side, the frequency against the simulation's own oscillation. */
 #include <string.h>

@@ -36,6 +36,8 @@ struct hm_estimator_s {
   int have_speed;
   double speed_kmh, t_speed;
   hm_speed_refusal speed_refusal; /* the latest speed's (HM_SPEED_ACCEPTED once one is accepted) */
+  double t_refused;               /* when it came: the later of its stamp and the latest acceleration sample's (a
+                                     stamp not after the previous one, or not finite, still arrives now) */
   /* the tracked oscillation as of the last crossing (the crossing ring changes only there) */
   double trk_f, trk_spread, trk_amp;
   hm_estimate counters;          /* only the counters are used */
@@ -293,6 +295,7 @@ void hm_estimator_reset(hm_estimator e) {
   e->speed_kmh = 0.0;
   e->t_speed = 0.0;
   e->speed_refusal = HM_SPEED_ACCEPTED;
+  e->t_refused = 0.0;
   memset(&e->counters, 0, sizeof e->counters);
 }
 
@@ -430,7 +433,7 @@ unsigned hm_estimator_last_fill(const hm_estimator e) { return e ? e->last_fill 
 const char *hm_speed_refusal_text(hm_speed_refusal r) {
   switch (r) {
     case HM_SPEED_ACCEPTED: return "";
-    case HM_SPEED_NOT_FINITE: return "not finite or negative";
+    case HM_SPEED_NOT_FINITE: return "not finite or negative (the speed or its stamp)";
     case HM_SPEED_ABOVE_MAX: return "above max_speed_kmh";
     case HM_SPEED_IMPLAUSIBLE: return "changing faster than max_speed_rate_kmh_s";
     case HM_SPEED_NOT_AFTER: return "stamped not after the previous one";
@@ -454,6 +457,7 @@ hm_status hm_estimator_push_speed(hm_estimator e, double t, double v) {
       why = HM_SPEED_IMPLAUSIBLE;
   }
   e->speed_refusal = why;
+  e->t_refused = isfinite(t) && (!e->have_sample || t > e->t_last) ? t : e->t_last;
   if (why != HM_SPEED_ACCEPTED) {
     e->counters.n_speed_rejected++;
     return HM_EDOMAIN;
@@ -482,7 +486,10 @@ void hm_estimator_read(const hm_estimator e, double now, hm_estimate *out) {
                   r.sample_rate_supported;
   r.speed_valid = e->have_speed && isfinite(now) && now - e->t_speed <= c->speed_timeout_s;
   r.speed_kmh = e->have_speed ? e->speed_kmh : 0.0;
-  r.speed_refused = r.speed_valid ? HM_SPEED_ACCEPTED : e->speed_refusal;
+  /* a refusal is told while it is recent (speeds still arrive), not after the speeds stopped */
+  r.speed_refused = !r.speed_valid && isfinite(now) && now - e->t_refused <= c->speed_timeout_s
+                        ? e->speed_refusal
+                        : HM_SPEED_ACCEPTED;
   const double f = e->have_sample ? e->trk_f : 0.0, spread = e->trk_spread, amp = e->trk_amp;
   const int settled = e->have_sample && e->t_last - e->t_start >= c->tracking_time_s;
   r.oscillation_valid = settled && f > 0.0;
