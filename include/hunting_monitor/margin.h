@@ -88,7 +88,8 @@ extern "C" {
 
 #define HM_MARGIN_MAX_WINDOWS 64
 /* Readings whose windows start within this of each other [s] are of one stretch (read again as it grows): where one
- * chose one pole pair and the other two, their conicities' difference is an error of the window's. */
+ * chose one pole pair and the other two, their conicities' difference is an error of the window's; a weak alternative
+ * read in one keeps being the others' (hm_margin_set_pending). */
 #define HM_MARGIN_SAME_STRETCH_S 0.5
 /* A window whose decay rate is within this of zero [1/s] is near evidence (the alarm lets an estimate outside the
  * prior, or a change's first window, set the interval only with it): 50 km/h below the default vehicle's Hopf speed
@@ -218,7 +219,10 @@ hm_status hm_margin_add_window(hm_margin m, double t_end_s, double speed_kmh, do
  * again at every fit, a stretch's reading may choose one pole pair at one fit and two at the next (modal.h: a mode
  * beside a broader resonance): once the stretch has been read both ways, each window of it (provisional, or a full
  * one offered by hm_margin_add_window) carries the difference of the two decompositions' latest conicities as a
- * systematic error (HM_MARGIN_SAME_STRETCH_S tells a stretch), so that the interval does not follow the flip. */
+ * systematic error (HM_MARGIN_SAME_STRETCH_S tells a stretch), so that the interval does not follow the flip. Likewise
+ * a weak alternative (modal.h's decay_rate_alt_1_s: two pairs the likelihood ratio could neither choose nor rule out)
+ * read in one fit of the stretch stays an error of the decay rate in its later fits that have none of their own (the
+ * ratio wanders about its threshold from fit to fit). */
 hm_status hm_margin_set_pending(hm_margin m, double t_end_s, double speed_kmh, double speed_spread_kmh,
                                 const hm_mode_estimate *mode, hm_window_verdict *verdict);
 void hm_margin_commit_pending(hm_margin m);

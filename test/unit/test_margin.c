@@ -229,6 +229,56 @@ static void a_stretch_read_both_ways(void) {
   hm_margin_destroy(m);
 }
 
+/* A weak alternative (modal.h: a mode beside a broader resonance the likelihood could not rule out) read in one fit
+ * of a stretch stays its error in the stretch's later fits without one (the campaign's broad_386: three fits with it
+ * at likelihood ratios 9-10, then none at 6-7.5, and the interval that had held the truth lay wholly above it): a later
+ * reading without it against the same reading carrying it itself; a new stretch (starting 5 s later) is not
+ * touched. */
+/* One reading alone in a new margin: the estimate at t. */
+static hm_margin_estimate read_alone(const hm_margin_config *c, double t, const hm_mode_estimate *e) {
+  hm_margin m = NULL;
+  hm_window_verdict v;
+  hm_margin_estimate r;
+  memset(&r, 0, sizeof r);
+  hm_margin_create(c, &vehicle, &m, NULL, 0);
+  hm_margin_set_pending(m, t, 440.0, 1.0, e, &v);
+  hm_margin_read(m, t, &r);
+  hm_margin_destroy(m);
+  return r;
+}
+
+static void a_stretch_keeps_its_weak_alternative(void) {
+  hm_margin_config c;
+  hm_margin_config_default(&c);
+  hm_mode_estimate with = mode_at(0.16, 440.0, 0.3, 0.05), without;
+  with.poles = 1, with.window_s = 20.0;
+  with.decay_rate_alt_1_s = with.decay_rate_1_s + 0.8; /* less damped */
+  without = with;
+  without.decay_rate_alt_1_s = 0.0;
+  without.window_s = 21.0; /* the same stretch (from 0 s), read a second later */
+  hm_mode_estimate carrying = without; /* the references: the later reading with and without it */
+  carrying.decay_rate_alt_1_s = with.decay_rate_alt_1_s;
+  const hm_margin_estimate carried = read_alone(&c, 21.0, &carrying), bare = read_alone(&c, 21.0, &without);
+  hm_window_verdict v;
+  hm_margin_estimate g;
+  hm_margin m = NULL;
+  hm_margin_create(&c, &vehicle, &m, NULL, 0);
+  hm_margin_set_pending(m, 20.0, 440.0, 1.0, &with, &v);
+  hm_margin_set_pending(m, 21.0, 440.0, 1.0, &without, &v);
+  hm_margin_read(m, 21.0, &g);
+  printf("  the later fit alone %.4f +- %.4f, carrying the alternative +- %.4f; after a fit with it: +- %.4f\n",
+         bare.conicity, bare.conicity_se, carried.conicity_se, g.conicity_se);
+  HM_CHECK(v == HM_WINDOW_USED && carried.conicity_se > 1.5 * bare.conicity_se, "the alternative matters: %g, %g",
+           carried.conicity_se, bare.conicity_se);
+  HM_CHECK_DELTA(g.conicity, bare.conicity, 1e-12, "its own conicity");
+  HM_CHECK_DELTA(g.conicity_se, carried.conicity_se, 1e-12, "the stretch's alternative kept");
+  without.window_s = 16.0; /* a new stretch: from 5 s, read at 21 s */
+  hm_margin_set_pending(m, 21.0, 440.0, 1.0, &without, &v);
+  hm_margin_read(m, 21.0, &g);
+  hm_margin_destroy(m);
+  HM_CHECK_DELTA(g.conicity_se, read_alone(&c, 21.0, &without).conicity_se, 1e-12, "another stretch: its own error");
+}
+
 /* A change of the conicity (issue #18): three windows of lambda 0.12 (Hopf 553.8 km/h) at 420-455 km/h, then one of
  * lambda 0.16 (473.8 km/h) at 460: far beyond 4 combined standard errors, so the windows held are dropped and the new
  * one is kept (the evidence of the change, issue #27: 0.16 at once, windows_since_change 1), the change counted; the
@@ -551,6 +601,7 @@ int main(void) {
   HM_RUN(refusals_and_mismatch);
   HM_RUN(pending_window_of_a_stretch);
   HM_RUN(a_stretch_read_both_ways);
+  HM_RUN(a_stretch_keeps_its_weak_alternative);
   HM_RUN(changes_misfits_and_disagreement);
   HM_TEST_EXIT();
 }

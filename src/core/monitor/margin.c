@@ -45,6 +45,12 @@ struct hm_margin_s {
     int valid;
     double start_s, lambda;
   } last[2];
+  /* the latest weak alternative (modal.h's decay_rate_alt_1_s) read in the stretch that starts at start_s: a later
+   * reading of the same stretch keeps it as its own alternative (stretch_alternative) */
+  struct {
+    int valid;
+    double start_s, sigma;
+  } alt;
 };
 
 const char *hm_window_verdict_text(hm_window_verdict v) {
@@ -147,6 +153,7 @@ void hm_margin_shift_time(hm_margin m, double delta_s) {
   m->pending_misfit_t += delta_s;
   m->last[0].start_s += delta_s;
   m->last[1].start_s += delta_s;
+  m->alt.start_s += delta_s;
   m->last_end_s += delta_s;
   if (m->n_changes) m->last_change_s += delta_s;
   if (m->narrow_at_s != 0.0) m->narrow_at_s += delta_s;
@@ -175,6 +182,7 @@ void hm_margin_reset(hm_margin m) {
   m->n_changes = 0;
   m->last_change_s = 0.0;
   m->last[0].valid = m->last[1].valid = 0;
+  m->alt.valid = 0;
 }
 
 double hm_margin_hopf_kmh(const hm_margin m, double conicity) {
@@ -216,9 +224,27 @@ static hm_status root_near(const hm_margin m, double speed_kmh, double conicity,
  * bogie's axle box -6.4 and -2.7 1/s in one window): the model-free line takes the windows of one kind only. */
 static int reads_by_model(const hm_margin m) { return m->model && hm_mode_model_has_sensor(m->model); }
 
-/* A reading's checks and inversion into *w (a window of window_s seconds); the verdict says whether it can be used. */
+/* The latest weak alternative decay rate (modal.h) read in the stretch of a window of window_s seconds ending at
+ * t_end (0: none), for a primary reading without one of its own (a stretch is read again at every fit while it grows, and the likelihood ratio of a mode beside a broader
+ * resonance wanders about HM_MODAL_TWO_PAIR_LR_WEAK from fit to fit: the campaign's broad_386, the mode -1.57 1/s
+ * beside one of -5.75, read one pair -2.4 to -2.6 with the alternative -1.74 to -1.85 for three fits at ratios 9-10,
+ * then without it at 6-7.5: the interval's error went with it and the interval lay wholly above the truth). */
+static double stretch_alternative(const hm_margin m, double t_end, double window_s) {
+  return m->alt.valid && fabs(m->alt.start_s - (t_end - window_s)) <= HM_MARGIN_SAME_STRETCH_S ? m->alt.sigma : 0.0;
+}
+
+/* Remember the primary reading's weak alternative for its stretch (stretch_alternative). */
+static void note_alternative(hm_margin m, double t_end, const hm_mode_estimate *mode) {
+  if (!(mode->decay_rate_alt_1_s < 0.0)) return;
+  m->alt.valid = 1;
+  m->alt.start_s = t_end - mode->window_s;
+  m->alt.sigma = mode->decay_rate_alt_1_s;
+}
+
+/* A reading's checks and inversion into *w (a window of window_s seconds; stretch_alt: the stretch's weak alternative
+ * decay rate for a reading without its own, 0 for none); the verdict says whether it can be used. */
 static hm_window_verdict prepare_reading(const hm_margin m, double t_end, double speed_kmh, double spread_kmh,
-                                         double window_s, const hm_mode_reading *mode, window *w) {
+                                         double window_s, const hm_mode_reading *mode, double stretch_alt, window *w) {
   const hm_margin_config *c = &m->cfg;
   if (!mode->valid) return HM_WINDOW_MODE_INVALID;
   if (spread_kmh > c->max_speed_spread_kmh) return HM_WINDOW_SPEED_VARIED;
@@ -226,9 +252,10 @@ static hm_window_verdict prepare_reading(const hm_margin m, double t_end, double
   if (t_end - window_s < m->last_end_s - 1e-9) return HM_WINDOW_OVERLAPS;
   /* statistical and systematic errors of the measured mode (the leakage of a T s window: about 1 / T) */
   double sys_sigma = c->decay_rate_model_error * fabs(mode->decay_rate_1_s) + 1.0 / fmax(window_s, 1.0);
-  /* a second reading the likelihood could not rule out (modal.h: a broad resonance beside the mode): the difference
-   * is an error of the decay rate */
-  if (mode->decay_rate_alt_1_s < 0.0) sys_sigma = hypot(sys_sigma, mode->decay_rate_1_s - mode->decay_rate_alt_1_s);
+  /* a second reading the likelihood could not rule out (modal.h: a broad resonance beside the mode), in this fit or
+   * an earlier one of the stretch: the difference is an error of the decay rate */
+  const double alt = mode->decay_rate_alt_1_s < 0.0 ? mode->decay_rate_alt_1_s : stretch_alt;
+  if (alt < 0.0) sys_sigma = hypot(sys_sigma, mode->decay_rate_1_s - alt);
   /* a decay rate at its bound 0 (a line's reading, or a mode narrower than the window resolves) inverted just below */
   const double sigma = fmin(mode->decay_rate_1_s, -1e-6);
   const double sys_f = c->frequency_model_error * mode->frequency_hz;
@@ -381,7 +408,8 @@ static hm_window_verdict prepare(const hm_margin m, double t_end, double speed_k
   hm_mode_reading primary;
   hm_mode_estimate_reading(mode, &primary);
   const hm_window_verdict v =
-      use_spectrum(m, mode, w, prepare_reading(m, t_end, speed_kmh, spread_kmh, mode->window_s, &primary, w));
+      use_spectrum(m, mode, w, prepare_reading(m, t_end, speed_kmh, spread_kmh, mode->window_s, &primary,
+                                               stretch_alternative(m, t_end, mode->window_s), w));
   *narrow = HM_NARROW_NONE;
   if (v == HM_WINDOW_USED || v == HM_WINDOW_MISFIT || v == HM_WINDOW_NO_INVERSION) {
     double lo, hi, se; /* the model's slope at the window's conicity, or (none found) at what is known */
@@ -395,7 +423,7 @@ static hm_window_verdict prepare(const hm_margin m, double t_end, double speed_k
   if (!tracked && v == HM_WINDOW_USED && supports_narrow(m, w)) return *narrow = HM_NARROW_MODE, v;
   window wl;
   const hm_window_verdict vl =
-      prepare_reading(m, t_end, speed_kmh, spread_kmh, mode->window_s, hm_mode_estimate_beside_line(mode), &wl);
+      prepare_reading(m, t_end, speed_kmh, spread_kmh, mode->window_s, hm_mode_estimate_beside_line(mode), 0.0, &wl);
   const int impossible = v == HM_WINDOW_MISFIT || v == HM_WINDOW_NO_INVERSION;
   const int beside = primary.poles == 2 || fabs(mode->line_reading.frequency_hz - primary.frequency_hz) > 1.0;
   /* the mode beside it, where what is known supports it, or where it is the cautious reading (wheels worn beyond the
@@ -493,6 +521,7 @@ hm_status hm_margin_add_window(hm_margin m, double t_end, double speed_kmh, doub
   hm_narrow_verdict narrow;
   *verdict = prepare(m, t_end, speed_kmh, spread_kmh, mode, &w, &narrow);
   across_fits(m, *verdict, &w);
+  note_alternative(m, t_end, mode);
   note_narrow(m, t_end, mode, narrow);
   m->pending_misfit = 0; /* a committed window ends the stretch's provisional one */
   if (*verdict == HM_WINDOW_MISFIT) misfit_push(m, t_end);
@@ -509,6 +538,7 @@ hm_status hm_margin_set_pending(hm_margin m, double t_end, double speed_kmh, dou
   hm_narrow_verdict narrow;
   *verdict = prepare(m, t_end, speed_kmh, spread_kmh, mode, &w, &narrow);
   across_fits(m, *verdict, &w);
+  note_alternative(m, t_end, mode);
   note_narrow(m, t_end, mode, narrow);
   m->pending_misfit = *verdict == HM_WINDOW_MISFIT;
   m->pending_misfit_t = t_end;
