@@ -277,6 +277,23 @@ static void a_stretch_keeps_its_weak_alternative(void) {
   hm_margin_read(m, 21.0, &g);
   hm_margin_destroy(m);
   HM_CHECK_DELTA(g.conicity_se, read_alone(&c, 21.0, &without).conicity_se, 1e-12, "another stretch: its own error");
+  /* a narrow peak read in the same stretch is another resonance: the broad reading's alternative is not its error
+   * (with it a narrow peak at 14.25 Hz had passed as the mode, a review found) */
+  hm_mode_estimate narrow = without;
+  narrow.window_s = 21.0;
+  narrow.narrow_peak = 1;
+  narrow.frequency_hz = narrow.narrow_peak_hz = 14.25;
+  narrow.decay_rate_1_s = -0.2, narrow.decay_rate_se_1_s = 0.1, narrow.frequency_se_hz = 0.005;
+  const hm_margin_estimate narrow_alone = read_alone(&c, 21.0, &narrow);
+  hm_margin_create(&c, &vehicle, &m, NULL, 0);
+  hm_margin_set_pending(m, 20.0, 440.0, 1.0, &with, &v);
+  hm_margin_set_pending(m, 21.0, 440.0, 1.0, &narrow, &v);
+  hm_margin_read(m, 21.0, &g);
+  hm_margin_destroy(m);
+  HM_CHECK(g.conicity_valid == narrow_alone.conicity_valid &&
+               (!g.conicity_valid || fabs(g.conicity_se - narrow_alone.conicity_se) < 1e-12),
+           "a narrow peak after it: as alone (valid %d / %d, +- %g / %g)", g.conicity_valid, narrow_alone.conicity_valid,
+           g.conicity_se, narrow_alone.conicity_se);
 }
 
 /* A change of the conicity (issue #18): three windows of lambda 0.12 (Hopf 553.8 km/h) at 420-455 km/h, then one of

@@ -233,9 +233,13 @@ static double stretch_alternative(const hm_margin m, double t_end, double window
   return m->alt.valid && fabs(m->alt.start_s - (t_end - window_s)) <= HM_MARGIN_SAME_STRETCH_S ? m->alt.sigma : 0.0;
 }
 
-/* Remember the primary reading's weak alternative for its stretch (stretch_alternative). */
-static void note_alternative(hm_margin m, double t_end, const hm_mode_estimate *mode) {
-  if (!(mode->decay_rate_alt_1_s < 0.0)) return;
+/* A reading the stretch's alternative belongs to: one pole pair, no narrow peak (a narrow peak's reading is another
+ * resonance than the broad one whose alternative it was: given its error it would pass as the mode, a review found). */
+static int takes_alternative(const hm_mode_estimate *mode) { return mode->poles == 1 && !mode->narrow_peak; }
+
+/* Remember a used one-pair reading's weak alternative for its stretch (stretch_alternative). */
+static void note_alternative(hm_margin m, double t_end, const hm_mode_estimate *mode, hm_window_verdict v) {
+  if (v != HM_WINDOW_USED || !takes_alternative(mode) || !(mode->decay_rate_alt_1_s < 0.0)) return;
   m->alt.valid = 1;
   m->alt.start_s = t_end - mode->window_s;
   m->alt.sigma = mode->decay_rate_alt_1_s;
@@ -409,7 +413,9 @@ static hm_window_verdict prepare(const hm_margin m, double t_end, double speed_k
   hm_mode_estimate_reading(mode, &primary);
   const hm_window_verdict v =
       use_spectrum(m, mode, w, prepare_reading(m, t_end, speed_kmh, spread_kmh, mode->window_s, &primary,
-                                               stretch_alternative(m, t_end, mode->window_s), w));
+                                               takes_alternative(mode) ? stretch_alternative(m, t_end, mode->window_s)
+                                                                       : 0.0,
+                                               w));
   *narrow = HM_NARROW_NONE;
   if (v == HM_WINDOW_USED || v == HM_WINDOW_MISFIT || v == HM_WINDOW_NO_INVERSION) {
     double lo, hi, se; /* the model's slope at the window's conicity, or (none found) at what is known */
@@ -521,7 +527,7 @@ hm_status hm_margin_add_window(hm_margin m, double t_end, double speed_kmh, doub
   hm_narrow_verdict narrow;
   *verdict = prepare(m, t_end, speed_kmh, spread_kmh, mode, &w, &narrow);
   across_fits(m, *verdict, &w);
-  note_alternative(m, t_end, mode);
+  note_alternative(m, t_end, mode, *verdict);
   note_narrow(m, t_end, mode, narrow);
   m->pending_misfit = 0; /* a committed window ends the stretch's provisional one */
   if (*verdict == HM_WINDOW_MISFIT) misfit_push(m, t_end);
@@ -538,7 +544,7 @@ hm_status hm_margin_set_pending(hm_margin m, double t_end, double speed_kmh, dou
   hm_narrow_verdict narrow;
   *verdict = prepare(m, t_end, speed_kmh, spread_kmh, mode, &w, &narrow);
   across_fits(m, *verdict, &w);
-  note_alternative(m, t_end, mode);
+  note_alternative(m, t_end, mode, *verdict);
   note_narrow(m, t_end, mode, narrow);
   m->pending_misfit = *verdict == HM_WINDOW_MISFIT;
   m->pending_misfit_t = t_end;
