@@ -504,7 +504,7 @@ static hm_level target_without_data(hm_alarm a, const hm_estimate *e, hm_assessm
   *reason = !e->sample_rate_supported ? HM_REASON_BAD_SAMPLE_RATE
             : !e->accel_valid         ? HM_REASON_NO_ACCEL
                                       : HM_REASON_NO_SPEED;
-  s->speed_refused = e->speed_valid ? HM_SPEED_ACCEPTED : e->speed_refused;
+  s->speed_refused = e->speed_refused; /* (HM_SPEED_ACCEPTED while the speed is current: estimator.h) */
   a->block_n = a->n_blocks = 0; /* no speed: the acceleration starts again */
   if (!a->latched) return HM_LEVEL_NO_DATA;
   /* a held ALARM outlives its data: nothing says the oscillation has gone (alarm.h) */

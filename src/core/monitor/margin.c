@@ -225,10 +225,11 @@ static hm_status root_near(const hm_margin m, double speed_kmh, double conicity,
 static int reads_by_model(const hm_margin m) { return m->model && hm_mode_model_has_sensor(m->model); }
 
 /* The latest weak alternative decay rate (modal.h) read in the stretch of a window of window_s seconds ending at
- * t_end (0: none), for a primary reading without one of its own (a stretch is read again at every fit while it grows, and the likelihood ratio of a mode beside a broader
- * resonance wanders about HM_MODAL_TWO_PAIR_LR_WEAK from fit to fit: the campaign's broad_386, the mode -1.57 1/s
- * beside one of -5.75, read one pair -2.4 to -2.6 with the alternative -1.74 to -1.85 for three fits at ratios 9-10,
- * then without it at 6-7.5: the interval's error went with it and the interval lay wholly above the truth). */
+ * t_end (0: none), for a primary reading without one of its own (a stretch is read again at every fit while it grows,
+ * and the likelihood ratio of a mode beside a broader resonance wanders about HM_MODAL_TWO_PAIR_LR_WEAK from fit to
+ * fit: the campaign's broad_386, the mode -1.57 1/s beside one of -5.75, read one pair -2.4 to -2.6 with the
+ * alternative -1.74 to -1.85 for three fits at ratios 9-10, then without it at 6-7.5: the interval's error went with
+ * it). */
 static double stretch_alternative(const hm_margin m, double t_end, double window_s) {
   return m->alt.valid && fabs(m->alt.start_s - (t_end - window_s)) <= HM_MARGIN_SAME_STRETCH_S ? m->alt.sigma : 0.0;
 }
