@@ -43,6 +43,11 @@
  *     carbody_mass_kg: 35000
  *     carbody_yaw_inertia_kg_m2: 1.8e6
  *     half_bogie_distance_m: 8.75
+ *     roll:                          # optional (config/car_roll.yaml): without it the carbody does not roll
+ *       inertia_kg_m2: 6.4e4
+ *       cg_height_m: 0.9
+ *       stiffness_n_m_rad: 2.6e6       # each bogie's
+ *       damping_n_m_s_rad: 6.76e4      # each bogie's
  * Each reader refuses the other models' configs: a model is never taken for another silently.
  */
 #ifndef HUNTING_MONITOR_CONFIG_H

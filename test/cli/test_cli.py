@@ -995,30 +995,43 @@ def bogie_matrix(v, lam, kx=8.96e6, ky=8.96e6, ratio=1.351186, ksy=2.5e5, csy=3e
     return A
 
 
-def car_matrix(v, lam, ratio=1.351186, ksy=2.5e5, csy=3e4, mc=35000.0, ic=1.8e6, a=8.75):
+def car_matrix(v, lam, ratio=1.351186, ksy=2.5e5, csy=3e4, mc=35000.0, ic=1.8e6, a=8.75, roll=None):
     """The linearised car of car.h from its header's equations: two bogies (bogie_matrix, their secondary acting on
-    the frame's motion relative to the carbody at x_j = +-a) and the carbody (mc yc'' = sum F_j, Ic psic'' = sum x_j
-    F_j + M_j); the 30 x 30 matrix at speed v [m/s] and conicity lam (config/car_default.yaml's values by default)."""
+    the frame's motion relative to the carbody at x_j = +-a, at h below its centre of mass) and the carbody
+    (mc yc'' = sum F_j, Ic psic'' = sum x_j F_j + M_j, with roll = (Ix, h, kr, cr) also Ix phic'' = sum (h F_j - kr
+    phic - cr phic') + mc g h phic); the 30 x 30 (32 x 32) matrix at speed v [m/s] and conicity lam
+    (config/car_default.yaml's values by default)."""
     import numpy as np
     mf, jf, ka, da, cd, kd, dd = 2600.0, 1800.0, 1.5e5, 1.0, 1e6, 5e7, 1.3
     kyaw = 2 * ka * da ** 2 + 2 * dd ** 2 * kd  # the air springs' and yaw dampers' yaw stiffness on psif - psic
-    A = np.zeros((30, 30))
+    n = 32 if roll else 30
+    ix, h, kr, cr = roll if roll else (1.0, 0.0, 0.0, 0.0)
+    A = np.zeros((n, n))
     Y, YD, P, PD = 26, 27, 28, 29
     A[Y, YD] = A[P, PD] = 1.0
+    if roll:
+        R, RD = 30, 31
+        A[R, RD] = 1.0
+        A[RD, R] = mc * 9.80665 * h / ix
     for j, x in enumerate((a, -a)):
         o = 13 * j
         A[o:o + 13, o:o + 13] = bogie_matrix(v, lam, ratio=ratio, ksy=ksy, csy=csy)
         yf, yfd, pf, u = o + 8, o + 9, o + 10, o + 12
-        # the frame: its secondary forces on yf - yc - x psic and psif - psic
+        # the frame: its secondary forces on yf - yc - x psic - h phic and psif - psic
         A[yfd, [Y, YD, P, PD]] += np.array([ksy, csy, ksy * x, csy * x]) / mf
         A[o + 11, P] += kyaw / jf
         A[u, P] -= kd * dd / cd
-        # the carbody: F_j = ksy (yf - yc - x psic) + csy (yf' - yc' - x psic'), M_j = 2 ka da^2 (psif - psic)
-        # + 2 dd kd (dd (psif - psic) - u)
-        F = np.zeros(30)
+        # the carbody: F_j = ksy (yf - yc - x psic - h phic) + csy (yf' - yc' - x psic' - h phic'),
+        # M_j = 2 ka da^2 (psif - psic) + 2 dd kd (dd (psif - psic) - u)
+        F = np.zeros(n)
         F[[yf, yfd, Y, YD, P, PD]] = [ksy, csy, -ksy, -csy, -ksy * x, -csy * x]
-        M = np.zeros(30)
+        M = np.zeros(n)
         M[[pf, P, u]] = [kyaw, -kyaw, -2 * dd * kd]
+        if roll:
+            F[[R, RD]] = [-ksy * h, -csy * h]
+            A[yfd, [R, RD]] += np.array([ksy * h, csy * h]) / mf
+            A[RD] += h * F / ix
+            A[RD, [R, RD]] -= np.array([kr, cr]) / ix
         A[YD] += F / mc
         A[PD] += (x * F + M) / ic
     return A
@@ -1126,6 +1139,23 @@ def test_car_critical_and_cycles():
         close(got["v_crit_kmh"], v_ref, 1e-4, f"carbody hunting's critical speed at {lam}")
         close(got["frequency_hz"], f_ref, 1e-4, f"carbody hunting's frequency at {lam}")
         assert got["mode"] == "carbody" and got["mode_energy_share"]["carbody"] > 0.9, got["mode_energy_share"]
+    # the carbody's roll (config/car_roll.yaml): 32 states; its critical speed, and the rolling carbody-hunting car's
+    # at conicity 0.01, against car_matrix's with roll
+    roll = (6.4e4, 0.9, 2.6e6, 6.76e4)
+    rolling = run_json("critical", "--config", os.path.join(SRC, "config", "car_roll.yaml"))
+    assert len(rolling["eigenvalues"]) == 32, len(rolling["eigenvalues"])
+    v_ref, f_ref = bisect_critical(lambda v: car_matrix(v, 0.1358, roll=roll))
+    close(rolling["v_crit_kmh"], v_ref, 1e-4, "the rolling car's critical speed against car_matrix")
+    close(rolling["frequency_hz"], f_ref, 1e-4, "the rolling car's critical frequency against car_matrix")
+    roll_text = open(os.path.join(SRC, "config", "car_roll.yaml")).read()
+    with tempfile.TemporaryDirectory() as d:
+        cfg = write_file(d, "hunt_roll.yaml", open(hunt).read() + roll_text[roll_text.index("  roll:"):])
+        got = run_json("critical", "--config", cfg, "--conicity", "0.01")
+        v_ref, f_ref = bisect_critical(lambda v: car_matrix(v, 0.01, ratio=1.0, ksy=4e5, csy=1e4, mc=30000.0, ic=2.5e6,
+                                                            roll=roll))
+        close(got["v_crit_kmh"], v_ref, 1e-4, "the rolling carbody hunting's critical speed")
+        close(got["frequency_hz"], f_ref, 1e-4, "the rolling carbody hunting's frequency")
+        assert got["mode"] == "carbody", got["mode_energy_share"]
 
 
 def test_bogie_and_car_simulate():

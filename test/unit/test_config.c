@@ -329,6 +329,62 @@ static void bogie_configs(void) {
   }
 }
 
+/* A car's optional roll (car.h): config/car_roll.yaml is car_default with its four values; a car without it does not
+ * roll; a roll section missing a key, not a mapping, or too soft to carry the carbody: clear errors, output untouched. */
+static void car_roll_configs(void) {
+  hm_car car, plain;
+  char name[HM_VEHICLE_NAME_MAX], err[256] = "";
+  HM_CHECK(hm_config_load_car(HM_SOURCE_DIR "/config/car_roll.yaml", &car, name, err, sizeof err) == HM_OK,
+           "load: %s", err);
+  HM_CHECK(hm_config_load_car(HM_SOURCE_DIR "/config/car_default.yaml", &plain, NULL, err, sizeof err) == HM_OK,
+           "load car_default: %s", err);
+  HM_CHECK(strcmp(name, "car_roll") == 0, "name '%s'", name);
+  HM_CHECK(plain.carbody_roll_inertia_kg_m2 == 0.0, "car_default does not roll");
+  HM_CHECK(car.carbody_roll_inertia_kg_m2 == 6.4e4 && car.carbody_cg_height_m == 0.9 &&
+               car.secondary_roll_stiffness_n_m_rad == 2.6e6 && car.secondary_roll_damping_n_m_s_rad == 6.76e4,
+           "the roll's values");
+  plain.carbody_roll_inertia_kg_m2 = car.carbody_roll_inertia_kg_m2;
+  plain.carbody_cg_height_m = car.carbody_cg_height_m;
+  plain.secondary_roll_stiffness_n_m_rad = car.secondary_roll_stiffness_n_m_rad;
+  plain.secondary_roll_damping_n_m_s_rad = car.secondary_roll_damping_n_m_s_rad;
+  HM_CHECK(memcmp(&plain, &car, sizeof car) == 0, "everything else as car_default");
+  FILE *f = fopen(HM_SOURCE_DIR "/config/car_roll.yaml", "rb");
+  char base[8192];
+  const size_t n = f ? fread(base, 1, sizeof base - 1, f) : 0;
+  if (f) fclose(f);
+  base[n] = '\0';
+  const struct {
+    const char *from, *to, *message;
+    hm_status status;
+  } cases[] = {
+      {"    damping_n_m_s_rad: 6.76e4", "    damping: 6.76e4", "car.roll.damping: unknown key", HM_EPARSE},
+      {"    cg_height_m: 0.9", "    cg_height_m: -0.9", "car.roll.cg_height_m: must be in [0, 5] (got -0.9)",
+       HM_EDOMAIN},
+      {"    stiffness_n_m_rad: 2.6e6", "    stiffness_n_m_rad: 1.5e5",
+       "car.roll.stiffness_n_m_rad: must exceed mc g h / 2", HM_EDOMAIN},
+      {"    inertia_kg_m2: 6.4e4", "    inertia_kg_m2: -1", "car.roll.inertia_kg_m2: must be >= 0 (got -1)",
+       HM_EDOMAIN},
+  };
+  for (size_t i = 0; i < sizeof cases / sizeof cases[0]; ++i) {
+    char text[8192];
+    const char *p = strstr(base, cases[i].from);
+    HM_CHECK(p != NULL, "case %zu: test bug", i);
+    if (!p) continue;
+    snprintf(text, sizeof text, "%.*s%s%s", (int)(p - base), base, cases[i].to, p + strlen(cases[i].from));
+    memset(&car, 0x11, sizeof car);
+    const hm_car before = car;
+    const hm_status st = hm_config_parse_car(text, strlen(text), "t", &car, NULL, err, sizeof err);
+    HM_CHECK(st == cases[i].status && strstr(err, cases[i].message), "case %zu: %s: '%s'", i, hm_status_str(st), err);
+    HM_CHECK(memcmp(&car, &before, sizeof car) == 0, "case %zu: output changed on failure", i);
+  }
+  char text[8192];
+  const char *roll = strstr(base, "  roll:");
+  HM_CHECK(roll != NULL, "test bug");
+  snprintf(text, sizeof text, "%.*s  roll: 3\n", roll ? (int)(roll - base) : 0, base);
+  HM_CHECK(hm_config_parse_car(text, strlen(text), "t", &car, NULL, err, sizeof err) == HM_EPARSE &&
+               strstr(err, "car.roll: expected a mapping"), "roll not a mapping: '%s'", err);
+}
+
 int main(void) {
   HM_RUN(monitor_settings);
   HM_RUN(format_round_trip);
@@ -337,5 +393,6 @@ int main(void) {
   HM_RUN(malformed_configs_get_clear_errors);
   HM_RUN(degenerate_documents);
   HM_RUN(bogie_configs);
+  HM_RUN(car_roll_configs);
   HM_TEST_EXIT();
 }

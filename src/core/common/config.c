@@ -342,13 +342,29 @@ static hm_status parse_bogie_section(parse_ctx *c, yaml_node_t *sec, hm_bogie *b
   return parse_number_section(c, sec, "bogie", fields, sizeof fields / sizeof fields[0], b);
 }
 
+/* car: its three numbers, and an optional roll: mapping (every key of it required; without it the carbody does not
+ * roll, car.h). */
 static hm_status parse_car_section(parse_ctx *c, yaml_node_t *sec, hm_car *car) {
+  static const char *const allowed[] = {"carbody_mass_kg", "carbody_yaw_inertia_kg_m2", "half_bogie_distance_m",
+                                        "roll", NULL};
   static const number_field fields[] = {
       {"carbody_mass_kg", 0, offsetof(hm_car, carbody_mass_kg)},
       {"carbody_yaw_inertia_kg_m2", 0, offsetof(hm_car, carbody_yaw_inertia_kg_m2)},
       {"half_bogie_distance_m", 0, offsetof(hm_car, half_bogie_distance_m)},
   };
-  return parse_number_section(c, sec, "car", fields, sizeof fields / sizeof fields[0], car);
+  static const number_field roll_fields[] = {
+      {"inertia_kg_m2", 0, offsetof(hm_car, carbody_roll_inertia_kg_m2)},
+      {"cg_height_m", 0, offsetof(hm_car, carbody_cg_height_m)},
+      {"stiffness_n_m_rad", 0, offsetof(hm_car, secondary_roll_stiffness_n_m_rad)},
+      {"damping_n_m_s_rad", 0, offsetof(hm_car, secondary_roll_damping_n_m_s_rad)},
+  };
+  hm_status st = check_keys(c, sec, "car", allowed);
+  for (size_t i = 0; st == HM_OK && i < sizeof fields / sizeof fields[0]; ++i)
+    st = get_number(c, sec, "car", fields[i].key, (double *)((char *)car + fields[i].offset));
+  yaml_node_t *roll = st == HM_OK ? map_get(c, sec, "roll") : NULL;
+  if (roll && roll->type != YAML_MAPPING_NODE) return fail(c, roll, HM_EPARSE, "car.roll: expected a mapping of keys");
+  if (roll) st = parse_number_section(c, roll, "car.roll", roll_fields, sizeof roll_fields / sizeof roll_fields[0], car);
+  return st;
 }
 
 hm_status hm_config_model_kind(const char *text, size_t len, const char *source, hm_model_kind *kind, char *err,

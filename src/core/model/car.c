@@ -28,10 +28,29 @@ hm_status hm_car_validate(const hm_car *car, char *why, size_t why_len) {
       {"car.carbody_yaw_inertia_kg_m2", car->carbody_yaw_inertia_kg_m2, HM_RULE_POSITIVE, 0.0, 0.0},
       {"car.half_bogie_distance_m", car->half_bogie_distance_m, HM_RULE_POSITIVE, 0.0, 0.0},
   };
-  return hm_check_fields(checks, sizeof checks / sizeof checks[0], why, why_len);
+  st = hm_check_fields(checks, sizeof checks / sizeof checks[0], why, why_len);
+  if (st != HM_OK) return st;
+  const hm_field_check roll[] = {
+      {"car.roll.inertia_kg_m2", car->carbody_roll_inertia_kg_m2, HM_RULE_NONNEG, 0.0, 0.0},
+      {"car.roll.cg_height_m", car->carbody_cg_height_m, HM_RULE_RANGE, 0.0, 5.0},
+      {"car.roll.stiffness_n_m_rad", car->secondary_roll_stiffness_n_m_rad, HM_RULE_POSITIVE, 0.0, 0.0},
+      {"car.roll.damping_n_m_s_rad", car->secondary_roll_damping_n_m_s_rad, HM_RULE_NONNEG, 0.0, 0.0},
+  };
+  if (!(car->carbody_roll_inertia_kg_m2 > 0.0)) return hm_check_fields(roll, 1, why, why_len);
+  if ((st = hm_check_fields(roll, sizeof roll / sizeof roll[0], why, why_len)) != HM_OK) return st;
+  const double tipping = car->carbody_mass_kg * HM_CAR_GRAVITY_MPS2 * car->carbody_cg_height_m;
+  if (!(2.0 * car->secondary_roll_stiffness_n_m_rad > tipping))
+    return hm_reject(why, why_len, "car.roll.stiffness_n_m_rad",
+                     "must exceed mc g h / 2 (the carbody's weight on its springs tips it over)",
+                     car->secondary_roll_stiffness_n_m_rad);
+  return HM_OK;
 }
 
 static const char *const CAR_BODIES[] = {"wheelsets", "bogie frame", "carbody"};
+
+static size_t car_dim(const hm_car_model *m) {
+  return m->carbody_held ? HM_CAR_HELD_DIM : m->rolls ? HM_CAR_DIM : HM_CAR_RIGID_DIM;
+}
 
 static hm_status sys_rhs(const void *model, double v, const double *x, double *dx) {
   return hm_car_rhs((const hm_car_model *)model, v, x, NULL, dx);
@@ -72,8 +91,10 @@ hm_status hm_car_model_init(hm_car_model *m, const hm_car *car, int carbody_held
       w.scale[NB * j + i] = w.bogie.scale[i];
       w.body[NB * j + i] = w.bogie.body[i];
     }
-  const double car_inertia[4] = {0.0, car->carbody_mass_kg, 0.0, car->carbody_yaw_inertia_kg_m2};
-  for (int i = 0; i < 4; ++i) {
+  w.rolls = car->carbody_roll_inertia_kg_m2 > 0.0;
+  const double car_inertia[6] = {0.0, car->carbody_mass_kg, 0.0, car->carbody_yaw_inertia_kg_m2, 0.0,
+                                 car->carbody_roll_inertia_kg_m2};
+  for (int i = 0; i < (w.rolls ? 6 : 4); ++i) {
     w.inertia[YC + i] = car_inertia[i];
     w.scale[YC + i] = i % 2 ? 0.1 : 1e-3;
     w.body[YC + i] = 2;
@@ -82,7 +103,7 @@ hm_status hm_car_model_init(hm_car_model *m, const hm_car *car, int carbody_held
   w.x_m[0] = a + b, w.x_m[1] = a - b, w.x_m[2] = -a + b, w.x_m[3] = -a - b;
   w.y_state[0] = 0, w.y_state[1] = 4, w.y_state[2] = NB, w.y_state[3] = NB + 4;
   *m = w;
-  *sys = (hm_system){m->carbody_held ? HM_CAR_HELD_DIM : HM_CAR_DIM, sys_rhs, sys_jac, sys_dfdv, m, 3, CAR_BODIES,
+  *sys = (hm_system){car_dim(m), sys_rhs, sys_jac, sys_dfdv, m, 3, CAR_BODIES,
                      m->body, m->inertia, m->scale, 0, 1, bogie_sys.odd, sys_rhs_track, 4, m->x_m, m->y_state};
   return HM_OK;
 }
@@ -91,10 +112,13 @@ hm_status hm_car_rhs(const hm_car_model *m, double v, const double *x, const dou
   const hm_car *car = &m->car;
   const double xs[2] = {car->half_bogie_distance_m, -car->half_bogie_distance_m};
   const double *c = x + YC;
+  /* the carbody's lateral motion at the secondary's level: its roll's part */
+  const double h = car->carbody_cg_height_m, roll = m->rolls ? h * c[4] : 0.0, roll_rate = m->rolls ? h * c[5] : 0.0;
   double dx[HM_CAR_DIM], fy = 0.0, mz = 0.0;
   for (int j = 0; j < 2; ++j) {
     double att[4] = {0.0, 0.0, 0.0, 0.0}, f, mo;
-    if (!m->carbody_held) att[0] = c[0] + xs[j] * c[2], att[1] = c[1] + xs[j] * c[3], att[2] = c[2], att[3] = c[3];
+    if (!m->carbody_held)
+      att[0] = c[0] + xs[j] * c[2] + roll, att[1] = c[1] + xs[j] * c[3] + roll_rate, att[2] = c[2], att[3] = c[3];
     hm_status st = hm_bogie_rhs_under(&m->bogie, v, x + NB * j, y_track_m ? y_track_m + 2 * j : NULL, att,
                                       dx + NB * j, &f, &mo);
     if (st != HM_OK) return st;
@@ -107,17 +131,57 @@ hm_status hm_car_rhs(const hm_car_model *m, double v, const double *x, const dou
     dx[YC + 1] = fy / car->carbody_mass_kg;
     dx[YC + 2] = c[3];
     dx[YC + 3] = mz / car->carbody_yaw_inertia_kg_m2;
-    n = HM_CAR_DIM;
-    if (!isfinite(dx[YC + 1]) || !isfinite(dx[YC + 3])) return HM_ENONFINITE;
+    if (m->rolls) {
+      const double kr = 2.0 * car->secondary_roll_stiffness_n_m_rad - car->carbody_mass_kg * HM_CAR_GRAVITY_MPS2 * h;
+      dx[YC + 4] = c[5];
+      dx[YC + 5] = (h * fy - kr * c[4] - 2.0 * car->secondary_roll_damping_n_m_s_rad * c[5]) /
+                   car->carbody_roll_inertia_kg_m2;
+    }
+    n = car_dim(m);
+    if (!isfinite(dx[YC + 1]) || !isfinite(dx[YC + 3]) || (m->rolls && !isfinite(dx[YC + 5]))) return HM_ENONFINITE;
   }
   memcpy(dxdt, dx, n * sizeof(double));
   return HM_OK;
 }
 
+/* The Jacobian's entries of the roll (car.h): h phic in each secondary's lateral motion, the roll's own row. */
+static void roll_rows(const hm_car_model *m, double *J, size_t n) {
+  const hm_car *car = &m->car;
+  const hm_bogie *b = &car->bogie;
+  const double mf = b->frame_mass_kg, mc = car->carbody_mass_kg, ic = car->carbody_yaw_inertia_kg_m2;
+  const double ix = car->carbody_roll_inertia_kg_m2, h = car->carbody_cg_height_m;
+  const double ksy = b->secondary_lat_stiffness_n_m, csy = b->secondary_lat_damping_n_s_m;
+  const double xs[2] = {car->half_bogie_distance_m, -car->half_bogie_distance_m};
+  const size_t P = YC + 4, PD = YC + 5;
+#define AT(i, j) J[n * (size_t)(i) + (size_t)(j)]
+  AT(P, PD) = 1.0;
+  AT(PD, P) = (mc * HM_CAR_GRAVITY_MPS2 * h - 2.0 * car->secondary_roll_stiffness_n_m_rad) / ix;
+  AT(PD, PD) = -2.0 * car->secondary_roll_damping_n_m_s_rad / ix;
+  for (int j = 0; j < 2; ++j) {
+    const int o = NB * j;
+    /* F_j = Ksy (yf - yc - x_j psic - h phic) + Csy (...)': its dependence on the roll, and the roll's on it */
+    AT(o + 9, P) = ksy * h / mf;
+    AT(o + 9, PD) = csy * h / mf;
+    AT(YC + 1, P) -= ksy * h / mc;
+    AT(YC + 1, PD) -= csy * h / mc;
+    AT(YC + 3, P) -= xs[j] * ksy * h / ic;
+    AT(YC + 3, PD) -= xs[j] * csy * h / ic;
+    AT(PD, o + 8) = h * ksy / ix;
+    AT(PD, o + 9) = h * csy / ix;
+    AT(PD, YC) -= h * ksy / ix;
+    AT(PD, YC + 1) -= h * csy / ix;
+    AT(PD, YC + 2) -= h * xs[j] * ksy / ix;
+    AT(PD, YC + 3) -= h * xs[j] * csy / ix;
+    AT(PD, P) -= h * h * ksy / ix;
+    AT(PD, PD) -= h * h * csy / ix;
+  }
+#undef AT
+}
+
 hm_status hm_car_jacobian(const hm_car_model *m, double v, const double *x, double *jac) {
   const hm_car *car = &m->car;
   const hm_bogie *b = &car->bogie;
-  const size_t n = m->carbody_held ? HM_CAR_HELD_DIM : HM_CAR_DIM;
+  const size_t n = car_dim(m);
   const double xs[2] = {car->half_bogie_distance_m, -car->half_bogie_distance_m};
   double J[HM_CAR_DIM * HM_CAR_DIM], block[NB * NB];
   memset(J, 0, sizeof J);
@@ -162,6 +226,7 @@ hm_status hm_car_jacobian(const hm_car_model *m, double v, const double *x, doub
       AT(YC + 3, YC + 2) -= (xs[j] * xs[j] * ksy + kyaw) / ic;
       AT(YC + 3, YC + 3) -= xs[j] * xs[j] * csy / ic;
     }
+    if (m->rolls) roll_rows(m, J, n);
   }
 #undef AT
   memcpy(jac, J, n * n * sizeof(double));
@@ -169,7 +234,7 @@ hm_status hm_car_jacobian(const hm_car_model *m, double v, const double *x, doub
 }
 
 hm_status hm_car_dfdv(const hm_car_model *m, double v, const double *x, double *dfdv) {
-  const size_t n = m->carbody_held ? HM_CAR_HELD_DIM : HM_CAR_DIM;
+  const size_t n = car_dim(m);
   for (size_t i = 0; i < n; ++i) dfdv[i] = 0.0;
   for (int j = 0; j < 2; ++j) {
     hm_status st = hm_bogie_dfdv(&m->bogie, v, x + NB * j, dfdv + NB * j);

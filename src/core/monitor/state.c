@@ -145,11 +145,12 @@ static uint64_t monitor_hash(const hm_monitor m) {
                         b->secondary_lat_stiffness_n_m, b->secondary_lat_damping_n_s_m, b->airspring_long_stiffness_n_m,
                         b->airspring_half_distance_m, b->yaw_damper_damping_n_s_m, b->yaw_damper_stiffness_n_m,
                         b->yaw_damper_half_distance_m, p.carbody_mass_kg, p.carbody_yaw_inertia_kg_m2,
-                        p.half_bogie_distance_m};
+                        p.half_bogie_distance_m, p.carbody_roll_inertia_kg_m2, p.carbody_cg_height_m,
+                        p.secondary_roll_stiffness_n_m_rad, p.secondary_roll_damping_n_m_s_rad};
     h = fnv_u64(h, (uint64_t)kind);
     h = fnv_u64(h, (uint64_t)cfg.estimator.measurement_point); /* (the model's sensor: what its windows read) */
     for (size_t k = 0; k < sizeof v / sizeof v[0]; ++k)
-      if (kind == HM_MODEL_CAR || k < 10) h = fnv_f64(h, v[k]);
+      if ((kind == HM_MODEL_CAR && (k < 13 || p.carbody_roll_inertia_kg_m2 > 0.0)) || k < 10) h = fnv_f64(h, v[k]);
   }
   return h;
 }
