@@ -55,8 +55,9 @@ typedef struct {
 /* The default bogies (hm_bogie_default) under a high-speed carbody: mc 35 t, Ic 1.8e6 kg m^2, a 8.75 m. */
 void hm_car_default(hm_car *car);
 
-/* The bogie's checks (hm_bogie_validate), then mc, Ic, a > 0 ("car.carbody_mass_kg: must be > 0 (got -1)"); Ix >= 0
- * and with roll kr > 0, cr >= 0, h in [0, 5] m, and 2 kr > mc g h (else the carbody falls over on its springs). */
+/* The bogie's checks (hm_bogie_validate), then mc, Ic, a > 0 ("car.carbody_mass_kg: must be > 0 (got -1)"); Ix 0 (no
+ * roll) or in [1e3, 1e7] kg m^2, h in [0, 5] m, kr in [0, 1e8] N m/rad, cr in [0, 1e7] N m s/rad, and with roll
+ * 2 kr > mc g h (else the carbody falls over on its springs; the message gives the bound). */
 hm_status hm_car_validate(const hm_car *car, char *why, size_t why_len);
 
 typedef struct {

@@ -111,12 +111,7 @@ typedef struct {
   /* with a vehicle model (hm_margin_set_model): a window's conicity from the model's whole spectrum at the sensor over
    * this band [Hz] (spectrum_fit.h; both 0: off, the mode's reading inverted), with a relative systematic error; a
    * window whose spectrum's shape the model misses by more than spectrum_max_shape_chi2 (about chi2 with 5 degrees
-   * of freedom where it explains it) is a misfit; with spectrum_conicity one whose pole pairs misfit while the
-   * spectrum explains its shape is the reading's failing (HM_WINDOW_READING_MISFIT: not used, not counted toward
-   * model_mismatch; without it the pairs' reading is the conicity's source and its misfit counts). Measured on the
-   * strong yaw dampers' axle box (docs/VEHICLES.md): a heavily damped 13.4 Hz mode (-7.4 1/s) beside a 16.9 Hz one
-   * read as two pairs at 14.5 and 16.8 Hz, which no conicity's reading explains, while the spectrum's fit read 0.161
-   * +- 0.004 for 0.16; three such windows 100 km/h below the Hopf speed had raised model_mismatch for the run */
+   * of freedom where it explains it) is a misfit */
   double spectrum_low_hz, spectrum_high_hz;
   double spectrum_model_error;
   double spectrum_max_shape_chi2;
@@ -189,12 +184,9 @@ typedef enum {
                                supported (below): not used */
   HM_WINDOW_TRACKS_SPEED = 10, /* its peak moved with the speed as a track line does, not as the model's mode (below):
                                  not used, and not a misfit */
-  HM_WINDOW_TRACK_LINE = 11,  /* its narrow peak is a track line (its wavelength seen at another speed: track_lines.h)
+  HM_WINDOW_TRACK_LINE = 11   /* its narrow peak is a track line (its wavelength seen at another speed: track_lines.h)
                                  and the reading beside it is not one the model explains with what is known: not
                                  used, and not a misfit (the line's remains bias it) */
-  HM_WINDOW_READING_MISFIT = 12 /* its pole pairs misfit where the model's whole spectrum, which gives the conicity
-                                   (spectrum_conicity), explains the window: the reading's failing, not the
-                                   vehicle's; not used, and not a misfit */
 } hm_window_verdict;
 
 /* A short English sentence for a verdict; never NULL. */

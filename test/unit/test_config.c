@@ -361,8 +361,12 @@ static void car_roll_configs(void) {
       {"    cg_height_m: 0.9", "    cg_height_m: -0.9", "car.roll.cg_height_m: must be in [0, 5] (got -0.9)",
        HM_EDOMAIN},
       {"    stiffness_n_m_rad: 2.6e6", "    stiffness_n_m_rad: 1.5e5",
-       "car.roll.stiffness_n_m_rad: must exceed mc g h / 2", HM_EDOMAIN},
-      {"    inertia_kg_m2: 6.4e4", "    inertia_kg_m2: -1", "car.roll.inertia_kg_m2: must be >= 0 (got -1)",
+       "car.roll.stiffness_n_m_rad: must exceed mc g h / 2 = 154455", HM_EDOMAIN},
+      {"    inertia_kg_m2: 6.4e4", "    inertia_kg_m2: -1",
+       "car.roll.inertia_kg_m2: must be 0 (off) or in [1000, 1e+07] (got -1)", HM_EDOMAIN},
+      {"    inertia_kg_m2: 6.4e4", "    inertia_kg_m2: 1e-6", "car.roll.inertia_kg_m2: must be 0 (off) or in",
+       HM_EDOMAIN},
+      {"    stiffness_n_m_rad: 2.6e6", "    stiffness_n_m_rad: 1e300", "car.roll.stiffness_n_m_rad: must be in [0, 1e+08]",
        HM_EDOMAIN},
   };
   for (size_t i = 0; i < sizeof cases / sizeof cases[0]; ++i) {
@@ -378,6 +382,18 @@ static void car_roll_configs(void) {
     HM_CHECK(memcmp(&car, &before, sizeof car) == 0, "case %zu: output changed on failure", i);
   }
   char text[8192];
+  /* without roll (its inertia 0) the other keys are still checked */
+  char *ix = strstr(base, "inertia_kg_m2: 6.4e4"), *h = strstr(base, "cg_height_m: 0.9");
+  HM_CHECK(ix && h, "test bug");
+  if (ix && h) {
+    memcpy(ix, "inertia_kg_m2: 0    ", 20);
+    memcpy(h, "cg_height_m: -7 ", 16);
+    HM_CHECK(hm_config_parse_car(base, strlen(base), "t", &car, NULL, err, sizeof err) == HM_EDOMAIN &&
+                 strstr(err, "car.roll.cg_height_m: must be in [0, 5] (got -7)"),
+             "no roll, a bad height: '%s'", err);
+    memcpy(ix, "inertia_kg_m2: 6.4e4", 20);
+    memcpy(h, "cg_height_m: 0.9", 16);
+  }
   const char *roll = strstr(base, "  roll:");
   HM_CHECK(roll != NULL, "test bug");
   snprintf(text, sizeof text, "%.*s  roll: 3\n", roll ? (int)(roll - base) : 0, base);

@@ -6,7 +6,6 @@
 #include "hunting_monitor/inversion.h"
 #include "hunting_monitor/linear.h"
 #include "hunting_monitor/margin.h"
-#include "hunting_monitor/mode_model.h"
 
 static hm_vehicle vehicle;
 
@@ -608,52 +607,6 @@ static void estimates_outside_the_prior(void) {
   hm_margin_destroy(m);
 }
 
-/* A bogie's model at its axle box with the model's whole spectrum set (margin.h's use_spectrum): a window whose pole
- * pairs no conicity explains (a 19 Hz pair at 480 km/h, where the bogie has none) is a misfit, counted, when the
- * spectrum's shape is missed too (shape chi2 1000), and two raise model_mismatch; where the spectrum, which gives the
- * conicity, explains the window's shape (chi2 2) the pairs' misfit is the reading's: HM_WINDOW_READING_MISFIT,
- * neither used nor counted, and no number of them raises the mismatch; where the spectrum is a test only
- * (spectrum_conicity 0) the pairs' reading is the conicity's and its misfit counts. */
-static void a_reading_misfit_the_spectrum_explains(void) {
-  hm_car car;
-  hm_car_default(&car);
-  hm_mode_model model = NULL;
-  HM_CHECK(hm_mode_model_create_bogie(&car.bogie, &model) == HM_OK && hm_mode_model_set_band(model, 6.0, 22.0) == HM_OK &&
-               hm_mode_model_set_sensor(model, "axlebox") == HM_OK,
-           "the bogie's model at its axle box");
-  for (int run = 0; run < 3; ++run) {
-    const int explained = run > 0, reading = run == 1; /* (the spectrum's conicity taken: the pairs' misfit theirs) */
-    hm_margin_config c;
-    hm_margin_config_default(&c);
-    c.spectrum_low_hz = 6.0, c.spectrum_high_hz = 22.0, c.spectrum_conicity = run < 2;
-    hm_margin m = NULL;
-    HM_CHECK(hm_margin_create(&c, &car.bogie.wheelset, &m, NULL, 0) == HM_OK, "create");
-    if (!m) break;
-    hm_margin_set_model(m, model);
-    hm_mode_estimate e;
-    memset(&e, 0, sizeof e);
-    e.valid = 1, e.window_s = 40.0, e.poles = 1;
-    e.frequency_hz = 19.0, e.frequency_se_hz = 0.05, e.decay_rate_1_s = -1.0, e.decay_rate_se_1_s = 0.2;
-    e.spectrum_valid = 1, e.spectrum_conicity = 0.1358, e.spectrum_conicity_se = 0.002;
-    e.spectrum_model_share = 0.9, e.spectrum_shape_chi2 = explained ? 2.0 : 1000.0;
-    hm_window_verdict v = HM_WINDOW_USED;
-    hm_margin_estimate g;
-    for (int k = 0; k < 3; ++k) {
-      HM_CHECK(hm_margin_add_window(m, 40.0 * (k + 1), 480.0, 1.0, &e, &v) == HM_OK, "add");
-      HM_CHECK(v == (reading ? HM_WINDOW_READING_MISFIT : HM_WINDOW_MISFIT), "run %d, window %d: verdict %d", run, k,
-               v);
-    }
-    hm_margin_read(m, 120.0, &g);
-    HM_CHECK(reading ? g.n_misfits == 0 && !g.model_mismatch && g.n_windows == 0 : g.n_misfits == 3 && g.model_mismatch,
-             "run %d (shape %s): %u misfits, mismatch %d, %u windows", run, explained ? "explained" : "missed",
-             g.n_misfits, g.model_mismatch, g.n_windows);
-    HM_CHECK(strstr(hm_window_verdict_text(v), reading ? "whole spectrum explains" : "cannot explain") != NULL,
-             "the verdict's text: %s", hm_window_verdict_text(v));
-    hm_margin_destroy(m);
-  }
-  hm_mode_model_destroy(model);
-}
-
 int main(void) {
   hm_vehicle_default(&vehicle);
   HM_RUN(narrow_peaks);
@@ -667,6 +620,5 @@ int main(void) {
   HM_RUN(a_stretch_read_both_ways);
   HM_RUN(a_stretch_keeps_its_weak_alternative);
   HM_RUN(changes_misfits_and_disagreement);
-  HM_RUN(a_reading_misfit_the_spectrum_explains);
   HM_TEST_EXIT();
 }

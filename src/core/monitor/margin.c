@@ -67,8 +67,6 @@ const char *hm_window_verdict_text(hm_window_verdict v) {
     case HM_WINDOW_AMBIGUOUS:
       return "a narrow peak: a line, or the mode at its Hopf speed at a conicity nothing else supports: not used";
     case HM_WINDOW_TRACKS_SPEED: return "its peak moved with the speed like a track line, not like the mode: not used";
-    case HM_WINDOW_READING_MISFIT:
-      return "its pole pairs misfit where the model's whole spectrum explains it: not used, not a misfit";
     case HM_WINDOW_TRACK_LINE:
       return "its narrow peak is a track line seen at another speed, and the mode beside it is not explained: not used";
   }
@@ -312,23 +310,19 @@ static hm_window_verdict prepare_reading(const hm_margin m, double t_end, double
  * spectrum's shape (shape_chi2 above spectrum_max_shape_chi2: a vehicle that is not the model, whose frame's spectrum
  * a wrong conicity would be made to explain), where the model carries less than HM_MARGIN_SPECTRUM_MIN_SHARE of the
  * fitted power (the white floor explains the band: noise fits any conicity) or where the fit failed, the window is a
- * misfit: HM_WINDOW_MISFIT, else v unchanged; with spectrum_conicity 1 a window whose pole pairs misfit (v
- * HM_WINDOW_MISFIT) while the spectrum, which gives the conicity, explains its shape is HM_WINDOW_READING_MISFIT (the
- * pairs over a smooth background cannot hold what the model's several modes give: margin.h); with
- * spectrum_conicity 0 that test is all the fit does, and the pairs' misfit, theirs being the conicity, counts (an axle box, where a description whose frame is off still
+ * misfit: HM_WINDOW_MISFIT, else v unchanged; with
+ * spectrum_conicity 0 that test is all the fit does (an axle box, where a description whose frame is off still
  * explains the wheelsets' spectrum and the spectrum's narrow interval would hold a Hopf speed the description has
  * wrong: docs/VEHICLES.md). */
 static hm_window_verdict use_spectrum(const hm_margin m, const hm_mode_estimate *mode, window *w, hm_window_verdict v) {
-  if ((v != HM_WINDOW_USED && (v != HM_WINDOW_MISFIT || !m->cfg.spectrum_conicity)) || mode->narrow_peak ||
-      !reads_by_model(m) || !(m->cfg.spectrum_high_hz > 0.0) || mode->spectrum_valid == 0)
+  if (v != HM_WINDOW_USED || mode->narrow_peak || !reads_by_model(m) || !(m->cfg.spectrum_high_hz > 0.0) ||
+      mode->spectrum_valid == 0)
     return v;
-  const int explained = mode->spectrum_valid > 0 && mode->spectrum_conicity > 0.0 &&
-                        mode->spectrum_conicity_se > 0.0 && isfinite(mode->spectrum_conicity_se) &&
-                        mode->spectrum_model_share >= HM_MARGIN_SPECTRUM_MIN_SHARE &&
-                        mode->spectrum_shape_chi2 <= m->cfg.spectrum_max_shape_chi2;
-  if (!explained) return HM_WINDOW_MISFIT;
-  if (!m->cfg.spectrum_conicity) return v; /* (the test alone: the pairs' reading gives the conicity, its misfit counts) */
-  if (v == HM_WINDOW_MISFIT) return HM_WINDOW_READING_MISFIT;
+  if (mode->spectrum_valid < 0 || !(mode->spectrum_conicity > 0.0) || !(mode->spectrum_conicity_se > 0.0) ||
+      !isfinite(mode->spectrum_conicity_se) || !(mode->spectrum_model_share >= HM_MARGIN_SPECTRUM_MIN_SHARE) ||
+      !(mode->spectrum_shape_chi2 <= m->cfg.spectrum_max_shape_chi2))
+    return HM_WINDOW_MISFIT;
+  if (!m->cfg.spectrum_conicity) return v; /* (the test alone) */
   w->lambda = mode->spectrum_conicity;
   w->lambda_stat = mode->spectrum_conicity_se;
   w->lambda_sys = m->cfg.spectrum_model_error * mode->spectrum_conicity;
