@@ -252,6 +252,38 @@ static void monitor_settings(void) {
 /* The bogie and the car (issue #28): the shipped config/bogie_default.yaml and car_default.yaml hold hm_bogie_default's
  * and hm_car_default's values; the readers refuse each other's configs; the bogie section's errors are located like
  * the wheelset's. */
+/* An edit of a valid config's text (from replaced by to) and what its reader must say. */
+typedef struct {
+  const char *from, *to, *message;
+  hm_status status;
+} edit_case;
+
+typedef hm_status (*text_reader)(const char *text, size_t len, void *out, char *err, size_t err_len);
+static hm_status read_bogie(const char *text, size_t len, void *out, char *err, size_t err_len) {
+  return hm_config_parse_bogie(text, len, "t", out, NULL, err, err_len);
+}
+static hm_status read_car(const char *text, size_t len, void *out, char *err, size_t err_len) {
+  return hm_config_parse_car(text, len, "t", out, NULL, err, err_len);
+}
+
+/* Each case's edit of base read into out (size bytes, at most an hm_car's): its status and message, out untouched. */
+static void check_edits(const char *base, const edit_case *cases, size_t n, text_reader read, void *out, size_t size) {
+  unsigned char before[sizeof(hm_car)];
+  HM_CHECK(size <= sizeof before, "test bug");
+  for (size_t i = 0; i < n && size <= sizeof before; ++i) {
+    char text[8192], err[256] = "";
+    const char *p = strstr(base, cases[i].from);
+    HM_CHECK(p != NULL, "case %zu: test bug", i);
+    if (!p) continue;
+    snprintf(text, sizeof text, "%.*s%s%s", (int)(p - base), base, cases[i].to, p + strlen(cases[i].from));
+    memset(out, 0x11, size);
+    memcpy(before, out, size);
+    const hm_status st = read(text, strlen(text), out, err, sizeof err);
+    HM_CHECK(st == cases[i].status && strstr(err, cases[i].message), "case %zu: %s: '%s'", i, hm_status_str(st), err);
+    HM_CHECK(memcmp(out, before, size) == 0, "case %zu: output changed on failure", i);
+  }
+}
+
 static void bogie_configs(void) {
   hm_bogie b, d;
   char name[HM_VEHICLE_NAME_MAX], err[256] = "";
@@ -298,10 +330,7 @@ static void bogie_configs(void) {
                            "  airspring_long_stiffness_n_m: 1.5e5\n  airspring_half_distance_m: 1.0\n"
                            "  yaw_damper_damping_n_s_m: 1e6\n  yaw_damper_stiffness_n_m: 5e7\n"
                            "  yaw_damper_half_distance_m: 1.3\n";
-  const struct {
-    const char *from, *to, *message;
-    hm_status status;
-  } cases[] = {
+  const edit_case cases[] = {
       {"  frame_mass_kg: 2600\n", "  frame_mass_kg: -2600\n", "bogie.frame_mass_kg: must be > 0 (got -2600)",
        HM_EDOMAIN},
       {"  frame_mass_kg: 2600\n", "", "bogie.frame_mass_kg: missing key", HM_EPARSE},
@@ -315,18 +344,7 @@ static void bogie_configs(void) {
   char base[4096];
   snprintf(base, sizeof base, "%.*s%s", (int)(strstr(VALID, "monitor:") - VALID), VALID, bogie_text);
   HM_CHECK(hm_config_parse_bogie(base, strlen(base), "t", &b, NULL, err, sizeof err) == HM_OK, "base: %s", err);
-  for (size_t i = 0; i < sizeof cases / sizeof cases[0]; ++i) {
-    char text[4096];
-    const char *p = strstr(base, cases[i].from);
-    HM_CHECK(p != NULL, "case %zu: test bug", i);
-    if (!p) continue;
-    snprintf(text, sizeof text, "%.*s%s%s", (int)(p - base), base, cases[i].to, p + strlen(cases[i].from));
-    memset(&b, 0x11, sizeof b);
-    const hm_bogie before = b;
-    const hm_status st = hm_config_parse_bogie(text, strlen(text), "t", &b, NULL, err, sizeof err);
-    HM_CHECK(st == cases[i].status && strstr(err, cases[i].message), "case %zu: %s: '%s'", i, hm_status_str(st), err);
-    HM_CHECK(memcmp(&b, &before, sizeof b) == 0, "case %zu: output changed on failure", i);
-  }
+  check_edits(base, cases, sizeof cases / sizeof cases[0], read_bogie, &b, sizeof b);
 }
 
 /* A car's optional roll (car.h): config/car_roll.yaml is car_default with its four values; a car without it does not
@@ -353,10 +371,7 @@ static void car_roll_configs(void) {
   const size_t n = f ? fread(base, 1, sizeof base - 1, f) : 0;
   if (f) fclose(f);
   base[n] = '\0';
-  const struct {
-    const char *from, *to, *message;
-    hm_status status;
-  } cases[] = {
+  const edit_case cases[] = {
       {"    damping_n_m_s_rad: 6.76e4", "    damping: 6.76e4", "car.roll.damping: unknown key", HM_EPARSE},
       {"    cg_height_m: 0.9", "    cg_height_m: -0.9", "car.roll.cg_height_m: must be in [0, 5] (got -0.9)",
        HM_EDOMAIN},
@@ -369,18 +384,7 @@ static void car_roll_configs(void) {
       {"    stiffness_n_m_rad: 2.6e6", "    stiffness_n_m_rad: 1e300", "car.roll.stiffness_n_m_rad: must be in [0, 1e+08]",
        HM_EDOMAIN},
   };
-  for (size_t i = 0; i < sizeof cases / sizeof cases[0]; ++i) {
-    char text[8192];
-    const char *p = strstr(base, cases[i].from);
-    HM_CHECK(p != NULL, "case %zu: test bug", i);
-    if (!p) continue;
-    snprintf(text, sizeof text, "%.*s%s%s", (int)(p - base), base, cases[i].to, p + strlen(cases[i].from));
-    memset(&car, 0x11, sizeof car);
-    const hm_car before = car;
-    const hm_status st = hm_config_parse_car(text, strlen(text), "t", &car, NULL, err, sizeof err);
-    HM_CHECK(st == cases[i].status && strstr(err, cases[i].message), "case %zu: %s: '%s'", i, hm_status_str(st), err);
-    HM_CHECK(memcmp(&car, &before, sizeof car) == 0, "case %zu: output changed on failure", i);
-  }
+  check_edits(base, cases, sizeof cases / sizeof cases[0], read_car, &car, sizeof car);
   char text[8192];
   /* without roll (its inertia 0) the other keys are still checked */
   char *ix = strstr(base, "inertia_kg_m2: 6.4e4"), *h = strstr(base, "cg_height_m: 0.9");

@@ -63,12 +63,19 @@ static hm_status check_keys(parse_ctx *c, yaml_node_t *map, const char *section,
   return HM_OK;
 }
 
-static hm_status get_section(parse_ctx *c, yaml_node_t *root, const char *name, yaml_node_t **out) {
-  yaml_node_t *n = map_get(c, root, name);
-  if (!n) return fail(c, NULL, HM_EPARSE, "%s: missing section", name);
-  if (n->type != YAML_MAPPING_NODE) return fail(c, n, HM_EPARSE, "%s: expected a mapping of keys", name);
+/* The mapping under key in map (path names it in messages), or NULL when absent; not a mapping: an error. */
+static hm_status get_optional_section(parse_ctx *c, yaml_node_t *map, const char *key, const char *path,
+                                      yaml_node_t **out) {
+  yaml_node_t *n = map_get(c, map, key);
+  if (n && n->type != YAML_MAPPING_NODE) return fail(c, n, HM_EPARSE, "%s: expected a mapping of keys", path);
   *out = n;
   return HM_OK;
+}
+
+static hm_status get_section(parse_ctx *c, yaml_node_t *root, const char *name, yaml_node_t **out) {
+  hm_status st = get_optional_section(c, root, name, name, out);
+  if (st == HM_OK && !*out) return fail(c, NULL, HM_EPARSE, "%s: missing section", name);
+  return st;
 }
 
 /* A finite number from a scalar node (strtod accepts 1869, 8.96, 7.99e6). */
@@ -311,13 +318,15 @@ static hm_status read_small_file(parse_ctx *c, const char *path, char **text, si
 
 /* ---- the bogie (bogie.h) ---- */
 
-/* Every key of the section one of fields (all required), SI numbers into base + offset. */
+/* Every key of the section one of fields (all required; besides them the key sub where not NULL, a subsection the
+ * caller reads), SI numbers into base + offset. */
 static hm_status parse_number_section(parse_ctx *c, yaml_node_t *sec, const char *name, const number_field *fields,
-                                      size_t n, void *base) {
+                                      size_t n, void *base, const char *sub) {
   const char *allowed[16];
-  if (n >= 16) return fail(c, sec, HM_EINVAL, "%s: too many fields", name);
+  if (n >= 15) return fail(c, sec, HM_EINVAL, "%s: too many fields", name);
   for (size_t i = 0; i < n; ++i) allowed[i] = fields[i].key;
-  allowed[n] = NULL;
+  allowed[n] = sub;
+  allowed[n + 1] = NULL;
   hm_status st = check_keys(c, sec, name, allowed);
   for (size_t i = 0; st == HM_OK && i < n; ++i)
     st = get_number(c, sec, name, fields[i].key, (double *)((char *)base + fields[i].offset));
@@ -339,14 +348,12 @@ static hm_status parse_bogie_section(parse_ctx *c, yaml_node_t *sec, hm_bogie *b
       BF(yaw_damper_half_distance_m),
   };
 #undef BF
-  return parse_number_section(c, sec, "bogie", fields, sizeof fields / sizeof fields[0], b);
+  return parse_number_section(c, sec, "bogie", fields, sizeof fields / sizeof fields[0], b, NULL);
 }
 
 /* car: its three numbers, and an optional roll: mapping (every key of it required; without it the carbody does not
  * roll, car.h). */
 static hm_status parse_car_section(parse_ctx *c, yaml_node_t *sec, hm_car *car) {
-  static const char *const allowed[] = {"carbody_mass_kg", "carbody_yaw_inertia_kg_m2", "half_bogie_distance_m",
-                                        "roll", NULL};
   static const number_field fields[] = {
       {"carbody_mass_kg", 0, offsetof(hm_car, carbody_mass_kg)},
       {"carbody_yaw_inertia_kg_m2", 0, offsetof(hm_car, carbody_yaw_inertia_kg_m2)},
@@ -358,12 +365,11 @@ static hm_status parse_car_section(parse_ctx *c, yaml_node_t *sec, hm_car *car) 
       {"stiffness_n_m_rad", 0, offsetof(hm_car, secondary_roll_stiffness_n_m_rad)},
       {"damping_n_m_s_rad", 0, offsetof(hm_car, secondary_roll_damping_n_m_s_rad)},
   };
-  hm_status st = check_keys(c, sec, "car", allowed);
-  for (size_t i = 0; st == HM_OK && i < sizeof fields / sizeof fields[0]; ++i)
-    st = get_number(c, sec, "car", fields[i].key, (double *)((char *)car + fields[i].offset));
-  yaml_node_t *roll = st == HM_OK ? map_get(c, sec, "roll") : NULL;
-  if (roll && roll->type != YAML_MAPPING_NODE) return fail(c, roll, HM_EPARSE, "car.roll: expected a mapping of keys");
-  if (roll) st = parse_number_section(c, roll, "car.roll", roll_fields, sizeof roll_fields / sizeof roll_fields[0], car);
+  yaml_node_t *roll = NULL;
+  hm_status st = parse_number_section(c, sec, "car", fields, sizeof fields / sizeof fields[0], car, "roll");
+  if (st == HM_OK) st = get_optional_section(c, sec, "roll", "car.roll", &roll);
+  if (st == HM_OK && roll)
+    st = parse_number_section(c, roll, "car.roll", roll_fields, sizeof roll_fields / sizeof roll_fields[0], car, NULL);
   return st;
 }
 

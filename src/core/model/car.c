@@ -17,6 +17,12 @@ void hm_car_default(hm_car *car) {
   car->half_bogie_distance_m = 8.75;
 }
 
+/* The weight's term of the roll (car.h), mc g h [N m/rad], and the roll stiffness on both bogies less it. */
+static double weight_term(const hm_car *car) {
+  return car->carbody_mass_kg * HM_CAR_GRAVITY_MPS2 * car->carbody_cg_height_m;
+}
+static double roll_stiffness(const hm_car *car) { return 2.0 * car->secondary_roll_stiffness_n_m_rad - weight_term(car); }
+
 hm_status hm_car_validate(const hm_car *car, char *why, size_t why_len) {
   if (!car) {
     (void)hm_reject(why, why_len, "car", "NULL pointer", 0.0);
@@ -24,27 +30,23 @@ hm_status hm_car_validate(const hm_car *car, char *why, size_t why_len) {
   }
   hm_status st = hm_bogie_validate(&car->bogie, why, why_len);
   if (st != HM_OK) return st;
+  /* a carbody's roll inertia is 5e4-2e5 kg m^2 (0: no roll); far outside it the roll's pulsation sqrt(2 kr / Ix)
+   * leaves the simulations' explicit integrator steps of nanoseconds */
   const hm_field_check checks[] = {
       {"car.carbody_mass_kg", car->carbody_mass_kg, HM_RULE_POSITIVE, 0.0, 0.0},
       {"car.carbody_yaw_inertia_kg_m2", car->carbody_yaw_inertia_kg_m2, HM_RULE_POSITIVE, 0.0, 0.0},
       {"car.half_bogie_distance_m", car->half_bogie_distance_m, HM_RULE_POSITIVE, 0.0, 0.0},
-  };
-  st = hm_check_fields(checks, sizeof checks / sizeof checks[0], why, why_len);
-  if (st != HM_OK) return st;
-  /* a carbody's roll inertia is 5e4-2e5 kg m^2 (0: no roll); far outside it the roll's pulsation sqrt(2 kr / Ix)
-   * leaves the simulations' explicit integrator steps of nanoseconds */
-  const hm_field_check roll[] = {
       {"car.roll.inertia_kg_m2", car->carbody_roll_inertia_kg_m2, HM_RULE_OFF_OR_RANGE, 1e3, 1e7},
       {"car.roll.cg_height_m", car->carbody_cg_height_m, HM_RULE_RANGE, 0.0, 5.0},
       {"car.roll.stiffness_n_m_rad", car->secondary_roll_stiffness_n_m_rad, HM_RULE_RANGE, 0.0, 1e8},
       {"car.roll.damping_n_m_s_rad", car->secondary_roll_damping_n_m_s_rad, HM_RULE_RANGE, 0.0, 1e7},
   };
-  if ((st = hm_check_fields(roll, sizeof roll / sizeof roll[0], why, why_len)) != HM_OK) return st;
+  if ((st = hm_check_fields(checks, sizeof checks / sizeof checks[0], why, why_len)) != HM_OK) return st;
   if (!(car->carbody_roll_inertia_kg_m2 > 0.0)) return HM_OK;
-  const double tipping = car->carbody_mass_kg * HM_CAR_GRAVITY_MPS2 * car->carbody_cg_height_m;
-  if (!(2.0 * car->secondary_roll_stiffness_n_m_rad > tipping)) {
+  if (!(roll_stiffness(car) > 0.0)) {
     char reason[96];
-    snprintf(reason, sizeof reason, "must exceed mc g h / 2 = %.6g (the carbody's weight tips it over)", 0.5 * tipping);
+    snprintf(reason, sizeof reason, "must exceed mc g h / 2 = %.6g (the carbody's weight tips it over)",
+             0.5 * weight_term(car));
     return hm_reject(why, why_len, "car.roll.stiffness_n_m_rad", reason, car->secondary_roll_stiffness_n_m_rad);
   }
   return HM_OK;
@@ -136,9 +138,8 @@ hm_status hm_car_rhs(const hm_car_model *m, double v, const double *x, const dou
     dx[YC + 2] = c[3];
     dx[YC + 3] = mz / car->carbody_yaw_inertia_kg_m2;
     if (m->rolls) {
-      const double kr = 2.0 * car->secondary_roll_stiffness_n_m_rad - car->carbody_mass_kg * HM_CAR_GRAVITY_MPS2 * h;
       dx[YC + 4] = c[5];
-      dx[YC + 5] = (h * fy - kr * c[4] - 2.0 * car->secondary_roll_damping_n_m_s_rad * c[5]) /
+      dx[YC + 5] = (h * fy - roll_stiffness(car) * c[4] - 2.0 * car->secondary_roll_damping_n_m_s_rad * c[5]) /
                    car->carbody_roll_inertia_kg_m2;
     }
     n = car_dim(m);
@@ -159,7 +160,7 @@ static void roll_rows(const hm_car_model *m, double *J, size_t n) {
   const size_t P = YC + 4, PD = YC + 5;
 #define AT(i, j) J[n * (size_t)(i) + (size_t)(j)]
   AT(P, PD) = 1.0;
-  AT(PD, P) = (mc * HM_CAR_GRAVITY_MPS2 * h - 2.0 * car->secondary_roll_stiffness_n_m_rad) / ix;
+  AT(PD, P) = -roll_stiffness(car) / ix;
   AT(PD, PD) = -2.0 * car->secondary_roll_damping_n_m_s_rad / ix;
   for (int j = 0; j < 2; ++j) {
     const int o = NB * j;

@@ -149,8 +149,9 @@ static uint64_t monitor_hash(const hm_monitor m) {
                         p.secondary_roll_stiffness_n_m_rad, p.secondary_roll_damping_n_m_s_rad};
     h = fnv_u64(h, (uint64_t)kind);
     h = fnv_u64(h, (uint64_t)cfg.estimator.measurement_point); /* (the model's sensor: what its windows read) */
-    for (size_t k = 0; k < sizeof v / sizeof v[0]; ++k)
-      if ((kind == HM_MODEL_CAR && (k < 13 || p.carbody_roll_inertia_kg_m2 > 0.0)) || k < 10) h = fnv_f64(h, v[k]);
+    /* the bogie's 10, the car's 13, with roll all 17 (a car without roll hashes as before roll existed) */
+    const size_t n = kind != HM_MODEL_CAR ? 10 : p.carbody_roll_inertia_kg_m2 > 0.0 ? sizeof v / sizeof v[0] : 13;
+    for (size_t k = 0; k < n; ++k) h = fnv_f64(h, v[k]);
   }
   return h;
 }
