@@ -6,6 +6,7 @@
 #include "hunting_monitor/inversion.h"
 #include "hunting_monitor/linear.h"
 #include "hunting_monitor/margin.h"
+#include "hunting_monitor/mode_model.h"
 
 static hm_vehicle vehicle;
 
@@ -607,6 +608,63 @@ static void estimates_outside_the_prior(void) {
   hm_margin_destroy(m);
 }
 
+/* A bogie's model at its axle box with the model's whole spectrum set (margin.h's use_spectrum, reading_failed): a
+ * window whose pole pairs no conicity explains (a 19 Hz pair at 480 km/h, where the bogie has none) is a misfit,
+ * counted, and two raise model_mismatch; it is the reading's failing (HM_WINDOW_READING_MISFIT, neither used nor
+ * counted, no mismatch however many) only where the spectrum gives the conicity (spectrum_conicity), explains the
+ * window's shape (chi2 2 against 1000) and explains the pair's own peak: its part of the fit's residual within
+ * HM_MARGIN_READING_LOCAL_Z (0.5 against 40, a peak the model does not produce, e.g. a review's nearly undamped pair
+ * beside a spectrum at the shape test's limit; the part beside it does not count). The spectrum's band 6-22 Hz in 641
+ * bins (a 40 s window), 19 Hz in part 25 of 32. */
+static void a_reading_misfit_the_spectrum_explains(void) {
+  hm_car car;
+  hm_car_default(&car);
+  hm_mode_model model = NULL;
+  HM_CHECK(hm_mode_model_create_bogie(&car.bogie, &model) == HM_OK && hm_mode_model_set_band(model, 6.0, 22.0) == HM_OK &&
+               hm_mode_model_set_sensor(model, "axlebox") == HM_OK,
+           "the bogie's model at its axle box");
+  static const struct {
+    int spectrum_conicity;
+    double shape_chi2, z_at_pair, z_beside;
+    int reading; /* the pairs' failing, not the vehicle's */
+  } c[] = {{1, 2.0, 0.5, 0.5, 1}, {1, 2.0, 0.5, 40.0, 1}, {1, 2.0, 40.0, 0.5, 0}, {1, 1000.0, 0.5, 0.5, 0},
+           {0, 2.0, 0.5, 0.5, 0}};
+  for (size_t run = 0; run < sizeof c / sizeof c[0]; ++run) {
+    hm_margin_config mc;
+    hm_margin_config_default(&mc);
+    mc.spectrum_low_hz = 6.0, mc.spectrum_high_hz = 22.0, mc.spectrum_conicity = c[run].spectrum_conicity;
+    hm_margin m = NULL;
+    HM_CHECK(hm_margin_create(&mc, &car.bogie.wheelset, &m, NULL, 0) == HM_OK, "create");
+    if (!m) break;
+    hm_margin_set_model(m, model);
+    hm_mode_estimate e;
+    memset(&e, 0, sizeof e);
+    e.valid = 1, e.window_s = 40.0, e.poles = 1;
+    e.frequency_hz = 19.0, e.frequency_se_hz = 0.05, e.decay_rate_1_s = -1.0, e.decay_rate_se_1_s = 0.2;
+    e.spectrum_valid = 1, e.spectrum_conicity = 0.1358, e.spectrum_conicity_se = 0.002;
+    e.spectrum_model_share = 0.9, e.spectrum_shape_chi2 = c[run].shape_chi2;
+    e.spectrum_local_low_hz = 6.0, e.spectrum_local_high_hz = 22.0, e.spectrum_local_bins = 641;
+    for (int j = 0; j < HM_MODAL_SPECTRUM_LOCAL_PARTS; ++j) e.spectrum_local_z[j] = 0.5;
+    e.spectrum_local_z[25] = c[run].z_at_pair;
+    e.spectrum_local_z[27] = c[run].z_beside;
+    hm_window_verdict v = HM_WINDOW_USED;
+    hm_margin_estimate g;
+    for (int k = 0; k < 3; ++k) {
+      HM_CHECK(hm_margin_add_window(m, 40.0 * (k + 1), 480.0, 1.0, &e, &v) == HM_OK, "add");
+      HM_CHECK(v == (c[run].reading ? HM_WINDOW_READING_MISFIT : HM_WINDOW_MISFIT), "run %zu, window %d: verdict %d",
+               run, k, v);
+    }
+    hm_margin_read(m, 120.0, &g);
+    HM_CHECK(c[run].reading ? g.n_misfits == 0 && !g.model_mismatch && g.n_windows == 0
+                            : g.n_misfits == 3 && g.model_mismatch,
+             "run %zu: %u misfits, mismatch %d, %u windows", run, g.n_misfits, g.model_mismatch, g.n_windows);
+    HM_CHECK(strstr(hm_window_verdict_text(v), c[run].reading ? "whole spectrum explains" : "cannot explain") != NULL,
+             "the verdict's text: %s", hm_window_verdict_text(v));
+    hm_margin_destroy(m);
+  }
+  hm_mode_model_destroy(model);
+}
+
 int main(void) {
   hm_vehicle_default(&vehicle);
   HM_RUN(narrow_peaks);
@@ -620,5 +678,6 @@ int main(void) {
   HM_RUN(a_stretch_read_both_ways);
   HM_RUN(a_stretch_keeps_its_weak_alternative);
   HM_RUN(changes_misfits_and_disagreement);
+  HM_RUN(a_reading_misfit_the_spectrum_explains);
   HM_TEST_EXIT();
 }

@@ -7,6 +7,7 @@
 #include <string.h>
 
 #include "hunting_monitor/linear.h"
+#include "hunting_monitor/spectrum_fit.h"
 #include "validate.h"
 
 typedef struct {
@@ -69,6 +70,8 @@ const char *hm_window_verdict_text(hm_window_verdict v) {
     case HM_WINDOW_TRACKS_SPEED: return "its peak moved with the speed like a track line, not like the mode: not used";
     case HM_WINDOW_TRACK_LINE:
       return "its narrow peak is a track line seen at another speed, and the mode beside it is not explained: not used";
+    case HM_WINDOW_READING_MISFIT:
+      return "its pole pairs misfit where the model's whole spectrum explains it and their peaks: not used, not a misfit";
   }
   return "?";
 }
@@ -301,6 +304,31 @@ static hm_window_verdict prepare_reading(const hm_margin m, double t_end, double
   return HM_WINDOW_USED;
 }
 
+/* The model's whole spectrum explains the window (fitted, its share of the power and its shape's chi2 within bounds). */
+static int spectrum_explains(const hm_margin m, const hm_mode_estimate *mode) {
+  return mode->spectrum_valid > 0 && mode->spectrum_conicity > 0.0 && mode->spectrum_conicity_se > 0.0 &&
+         isfinite(mode->spectrum_conicity_se) && mode->spectrum_model_share >= HM_MARGIN_SPECTRUM_MIN_SHARE &&
+         mode->spectrum_shape_chi2 <= m->cfg.spectrum_max_shape_chi2;
+}
+
+/* ... and the peak of a pair (frequency, decay rate) of the window's reading: the residual's parts under f -+
+ * |sigma| / 2 pi within HM_MARGIN_READING_LOCAL_Z (margin.h). */
+static int spectrum_explains_peak(const hm_mode_estimate *mode, double f_hz, double sigma) {
+  const double hw = fabs(sigma) / (2.0 * HM_PI);
+  const double z = hm_spectrum_fit_local_z(mode->spectrum_local_z, mode->spectrum_local_low_hz,
+                                           mode->spectrum_local_high_hz, mode->spectrum_local_bins, f_hz - hw,
+                                           f_hz + hw);
+  return z <= HM_MARGIN_READING_LOCAL_Z; /* (NAN: a peak outside the fitted band, not explained) */
+}
+
+/* The window's pole pairs misfit (v HM_WINDOW_MISFIT) where the spectrum, which gives the conicity, explains the
+ * window and each pair's peak: the reading's failing (HM_WINDOW_READING_MISFIT, margin.h). */
+static int reading_failed(const hm_margin m, const hm_mode_estimate *mode) {
+  return m->cfg.spectrum_conicity && spectrum_explains(m, mode) &&
+         spectrum_explains_peak(mode, mode->frequency_hz, mode->decay_rate_1_s) &&
+         (mode->poles < 2 || spectrum_explains_peak(mode, mode->second_frequency_hz, mode->second_decay_rate_1_s));
+}
+
 /* A window whose mode the model explains (its reading inverted within max_misfit_chi2) takes its conicity from the
  * model's whole spectrum where that was fitted (spectrum_fit.h; a vehicle model, the spectrum's band set, no narrow
  * peak in the window): the reading's pole pairs hold a small part of what the spectrum tells (a frame's 8 Hz mode
@@ -310,19 +338,18 @@ static hm_window_verdict prepare_reading(const hm_margin m, double t_end, double
  * spectrum's shape (shape_chi2 above spectrum_max_shape_chi2: a vehicle that is not the model, whose frame's spectrum
  * a wrong conicity would be made to explain), where the model carries less than HM_MARGIN_SPECTRUM_MIN_SHARE of the
  * fitted power (the white floor explains the band: noise fits any conicity) or where the fit failed, the window is a
- * misfit: HM_WINDOW_MISFIT, else v unchanged; with
- * spectrum_conicity 0 that test is all the fit does (an axle box, where a description whose frame is off still
+ * misfit: HM_WINDOW_MISFIT, else v unchanged; a window whose pole pairs misfit (v HM_WINDOW_MISFIT) is
+ * HM_WINDOW_READING_MISFIT where reading_failed says so (spectrum_conicity 1). With spectrum_conicity 0 that test is
+ * all the fit does, and the pairs' misfit, theirs being the conicity, counts (an axle box, where a description whose frame is off still
  * explains the wheelsets' spectrum and the spectrum's narrow interval would hold a Hopf speed the description has
  * wrong: docs/VEHICLES.md). */
 static hm_window_verdict use_spectrum(const hm_margin m, const hm_mode_estimate *mode, window *w, hm_window_verdict v) {
-  if (v != HM_WINDOW_USED || mode->narrow_peak || !reads_by_model(m) || !(m->cfg.spectrum_high_hz > 0.0) ||
-      mode->spectrum_valid == 0)
+  if ((v != HM_WINDOW_USED && v != HM_WINDOW_MISFIT) || mode->narrow_peak || !reads_by_model(m) ||
+      !(m->cfg.spectrum_high_hz > 0.0) || mode->spectrum_valid == 0)
     return v;
-  if (mode->spectrum_valid < 0 || !(mode->spectrum_conicity > 0.0) || !(mode->spectrum_conicity_se > 0.0) ||
-      !isfinite(mode->spectrum_conicity_se) || !(mode->spectrum_model_share >= HM_MARGIN_SPECTRUM_MIN_SHARE) ||
-      !(mode->spectrum_shape_chi2 <= m->cfg.spectrum_max_shape_chi2))
-    return HM_WINDOW_MISFIT;
-  if (!m->cfg.spectrum_conicity) return v; /* (the test alone) */
+  if (v == HM_WINDOW_MISFIT) return reading_failed(m, mode) ? HM_WINDOW_READING_MISFIT : v;
+  if (!spectrum_explains(m, mode)) return HM_WINDOW_MISFIT;
+  if (!m->cfg.spectrum_conicity) return v; /* (the test alone: the pairs' reading gives the conicity, its misfit counts) */
   w->lambda = mode->spectrum_conicity;
   w->lambda_stat = mode->spectrum_conicity_se;
   w->lambda_sys = m->cfg.spectrum_model_error * mode->spectrum_conicity;

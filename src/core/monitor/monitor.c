@@ -367,6 +367,11 @@ static void spectrum_of(hm_monitor m, double t, double stretch_start, int full, 
   e->spectrum_motion_rms_m = fit->motion_rms_m;
   e->spectrum_shape_chi2 = fit->shape_chi2;
   e->spectrum_model_share = fit->model_share;
+  _Static_assert(HM_MODAL_SPECTRUM_LOCAL_PARTS == HM_SPECTRUM_FIT_LOCAL_PARTS, "the local residual's parts");
+  e->spectrum_local_low_hz = fit->local_low_hz;
+  e->spectrum_local_high_hz = fit->local_high_hz;
+  e->spectrum_local_bins = fit->bins;
+  memcpy(e->spectrum_local_z, fit->local_z, sizeof e->spectrum_local_z);
 }
 
 /* A fit of the identification. At a steady speed (the newest stretch whose speed varied by at most the margin's

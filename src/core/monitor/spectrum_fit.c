@@ -149,6 +149,14 @@ hm_status hm_spectrum_fit_conicity(hm_mode_model m, double speed_kmh, const hm_s
     const double mj = (double)(k1 - k0), z = (sx / mj - 1.0) / sqrt(2.0 / (dof * mj));
     shape += z * z;
   }
+  double local[HM_SPECTRUM_FIT_LOCAL_PARTS];
+  for (int j = 0; j < HM_SPECTRUM_FIT_LOCAL_PARTS; ++j) { /* the same, told part by part */
+    const size_t k0 = n * (size_t)j / HM_SPECTRUM_FIT_LOCAL_PARTS, k1 = n * (size_t)(j + 1) / HM_SPECTRUM_FIT_LOCAL_PARTS;
+    double sx = 0.0;
+    for (size_t k = k0; k < k1; ++k) sx += psd[k] / (amp * g[k] + fl);
+    const double mj = (double)(k1 - k0);
+    local[j] = (sx / mj - 1.0) / sqrt(2.0 / (dof * mj));
+  }
   const double dl = 0.01 * lam, lp = objective(&c, lam + dl), lm = objective(&c, lam - dl);
   const double curv = dof * (lp - 2.0 * l0 + lm) / (dl * dl);
   if (!isfinite(l0) || !isfinite(curv)) return HM_ENOCONV;
@@ -163,5 +171,29 @@ hm_status hm_spectrum_fit_conicity(hm_mode_model m, double speed_kmh, const hm_s
   out->deviance_per_bin = dev / (double)n;
   out->shape_chi2 = shape;
   out->model_share = carried / total;
+  out->local_low_hz = f_hz[0];
+  out->local_high_hz = f_hz[n - 1];
+  memcpy(out->local_z, local, sizeof local);
   return HM_OK;
+}
+
+/* The part holding bin k of n (the partition above). */
+static int part_of(size_t k, size_t n) {
+  int j = 0;
+  while (j + 1 < HM_SPECTRUM_FIT_LOCAL_PARTS && n * (size_t)(j + 1) / HM_SPECTRUM_FIT_LOCAL_PARTS <= k) ++j;
+  return j;
+}
+
+double hm_spectrum_fit_local_z(const double *local_z, double local_low_hz, double local_high_hz, size_t bins,
+                               double f_lo_hz, double f_hi_hz) {
+  const double span = local_high_hz - local_low_hz, mid = 0.5 * (f_lo_hz + f_hi_hz);
+  if (!local_z || bins < 2 || !(span > 0.0) || !isfinite(span) || !(f_hi_hz >= f_lo_hz) || !(mid >= local_low_hz) ||
+      !(mid <= local_high_hz))
+    return NAN;
+  const double per_bin = (double)(bins - 1) / span, last = (double)(bins - 1);
+  const size_t k0 = (size_t)fmin(last, fmax(0.0, round((f_lo_hz - local_low_hz) * per_bin)));
+  const size_t k1 = (size_t)fmin(last, fmax(0.0, round((f_hi_hz - local_low_hz) * per_bin)));
+  double worst = 0.0;
+  for (int j = part_of(k0, bins); j <= part_of(k1, bins); ++j) worst = fmax(worst, fabs(local_z[j]));
+  return worst;
 }
