@@ -127,14 +127,14 @@ typedef struct {
 
 /* Where the model's whole spectrum gives the windows' conicity (spectrum_conicity), a window whose pole pairs no
  * conicity's reading explains (HM_WINDOW_MISFIT) while that spectrum explains the window (its shape, its share) is
- * the reading's failing when the fit's residual also lies within this many standard errors in the parts under each
- * pair's peak (f -+ |sigma| / 2 pi; spectrum_fit.h's local_z): HM_WINDOW_READING_MISFIT. The bogie's axle box with
- * strong yaw dampers (docs/VEHICLES.md) reads its heavily damped 13.4 Hz mode beside a 16.9 Hz one as two pairs at
- * 14.5 and 16.8 Hz, or its 8 Hz mode as one pair, which the model's readings (several modes, the reading switching
- * between them with the conicity) cannot be inverted to, while the spectrum explains the window and its 0.161 +-
- * 0.004 is the truth's 0.16; three such windows had held model_mismatch for the run. A nearly undamped pair the model
- * does not produce stands tens of standard errors above the fit in its part (a review's case: without the local test
- * it was excused beside a spectrum at the shape test's limit). */
+ * the reading's failing when the fit's residual under each pair's peak (modal.h's spectrum_peak_z: the window's own
+ * spectrum over f -+ max(|sigma| / 2 pi, 2 / T) against the fit, in its standard errors) lies within this:
+ * HM_WINDOW_READING_MISFIT. The bogie's axle box with strong yaw dampers (docs/VEHICLES.md) reads its heavily damped
+ * 13.4 Hz mode beside a 16.9 Hz one as two pairs at 14.5 and 16.8 Hz, or its 8 Hz mode as one pair, which the model's
+ * readings (several modes, the reading switching between them with the conicity) cannot be inverted to, while the
+ * spectrum explains the window and its 0.161 +- 0.004 is the truth's 0.16; three such windows had held model_mismatch
+ * for the run. A narrow peak the model does not produce (a review's nearly undamped pair; one bin 20 times the fit in
+ * the monitor's periodogram, dof about 2, stands about 19 out) stays a misfit. */
 #define HM_MARGIN_READING_LOCAL_Z 5.0
 
 /* Defaults: 1%, 5%, 12 km/h, 200 km/h, 900 s, 20 km/h, 150 km/h, z = 2 (about 95%), misfit chi2 9 (3 standard

@@ -147,9 +147,6 @@ typedef struct {
   unsigned iterations;         /* scoring steps of the fits of this reading */
 } hm_mode_reading;
 
-/* The parts of the spectrum's fit's local residual an estimate carries (spectrum_fit.h's HM_SPECTRUM_FIT_LOCAL_PARTS) */
-#define HM_MODAL_SPECTRUM_LOCAL_PARTS 32
-
 typedef struct {
   int valid;                   /* the fit converged with the mode inside the band */
   double window_s;             /* data in the window [s] */
@@ -218,10 +215,9 @@ typedef struct {
   int spectrum_valid;           /* 1 fitted, 0 not asked, -1 asked and failed (no spectrum, or no fit: a misfit) */
   double spectrum_conicity, spectrum_conicity_se, spectrum_conicity_at_rest, spectrum_motion_rms_m;
   double spectrum_shape_chi2, spectrum_model_share;
-  /* and its residual part by part (spectrum_fit.h's local_z over [local_low_hz, local_high_hz]) */
-  double spectrum_local_low_hz, spectrum_local_high_hz;
-  size_t spectrum_local_bins;
-  double spectrum_local_z[HM_MODAL_SPECTRUM_LOCAL_PARTS];
+  /* and its residual under the reading's peaks (spectrum_fit.h's hm_spectrum_fit_peak_z over f -+ max(|sigma| / 2 pi,
+   * 2 / T) of the window's spectrum): the first pair's and the second's (NAN: not measured) */
+  double spectrum_peak_z, spectrum_second_peak_z;
 } hm_mode_estimate;
 
 /* The window's halves' speeds must differ by at least this in ln(V2 / V1) for speed_tracking: a line then moves 1% of

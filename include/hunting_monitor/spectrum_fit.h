@@ -32,9 +32,6 @@ extern "C" {
 #define HM_SPECTRUM_FIT_MAX_BINS 4096
 #define HM_SPECTRUM_FIT_MAX_PASSES 8
 #define HM_SPECTRUM_FIT_SHAPE_PARTS 8
-/* The fit's residual told locally: the bins in this many equal parts (0.5 Hz over 6-22 Hz), each part's mean of x
- * against 1 in its standard error (local_z below) */
-#define HM_SPECTRUM_FIT_LOCAL_PARTS 32
 /* The linearisation has settled when the motion it was made about and the one its fit implies agree to this
  * (relative); the default bogie's frame at 1 mm settles in 2-3 passes, at 1.6 mm (irregularity 1) in 4 (a review's: 2
  * passes had left it 3% of the conicity off) */
@@ -67,18 +64,20 @@ typedef struct {
   double model_share;            /* of the fitted spectrum's power over the bins, the model's (the rest the white
                                     floor's): near 0 where the floor explains the band (noise, or a sensor that sees
                                     none of the model's motion), whatever the conicity and the shape's chi2 say */
-  /* the residual where it lies: the bins in HM_SPECTRUM_FIT_LOCAL_PARTS equal parts from local_low_hz to
-   * local_high_hz (the first bin's frequency and the last's), each part's mean of x less 1 over its standard error
-   * sqrt(2 / (dof m)) (about N(0, 1) where the model's spectrum is the measured one there; a peak the model does not
-   * produce, tens or more) */
-  double local_low_hz, local_high_hz;
-  double local_z[HM_SPECTRUM_FIT_LOCAL_PARTS];
+  hm_running running;            /* the linearisation the last pass's spectrum was made about (hm_spectrum_fit_peak_z) */
 } hm_spectrum_fit;
 
-/* The largest |local_z| of the parts holding the bins nearest to [f_lo_hz, f_hi_hz] (bins: the fit's, evenly spaced
- * from local_low_hz to local_high_hz); NAN for no fit or a range's middle outside the fitted band. */
-double hm_spectrum_fit_local_z(const double *local_z, double local_low_hz, double local_high_hz, size_t bins,
-                               double f_lo_hz, double f_hi_hz);
+/* The fit's residual under a peak: over the bins of psd[] (the spectrum fitted, or a later one of the same band and
+ * dof: f_hz rising, gaps allowed, as the monitor's window spectrum leaves them where it set lines aside) whose
+ * frequencies lie in [f_lo_hz, f_hi_hz] (or the one nearest to its middle where none does), the mean of x = psd /
+ * (amplitude g + noise), g the model's spectrum at the fit's conicity and linearisation, less 1, over its standard
+ * error sqrt(2 / (dof m)) for m bins: about N(0, 1) where the model's spectrum is the measured one there; a peak the
+ * model does not produce, one bin 20 times the fit in a periodogram (dof 2), about 19. HM_EDOMAIN for bad input
+ * (f_lo_hz above f_hi_hz, the range's middle outside the bins, non-finite values), HM_ENOCONV where the model gives
+ * no spectrum; *z untouched then. */
+hm_status hm_spectrum_fit_peak_z(hm_mode_model m, double speed_kmh, const hm_sensor_point *point,
+                                 const hm_spectrum_fit *fit, const double *f_hz, const double *psd, size_t n,
+                                 double dof, double f_lo_hz, double f_hi_hz, double *z);
 
 /* The conicity whose spectrum at the point explains psd[] at f_hz[] (n bins, each > 0 and finite, the frequencies
  * rising) best at the speed [km/h]. HM_EDOMAIN for bad input (n below 4 HM_SPECTRUM_FIT_SHAPE_PARTS or above

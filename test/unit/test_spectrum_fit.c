@@ -108,28 +108,47 @@ static void finds_the_conicity(void) {
            kind ? "bogie" : "wheelset", c.v_start_kmh, fit.conicity, fit.conicity_se, nb, dof);
     HM_CHECK(fabs(fit.conicity - 0.1358) <= fmax(3.0 * fit.conicity_se, 0.002) && fit.conicity_se < 0.01,
              "the conicity found again");
-    /* the residual part by part: each part's mean of x is 1 within its standard error where the model is the
-     * recording's (32 standard normals beyond 5 once in 2e5; the model's linearisation and the recording's finite
-     * length add a little: the largest seen 3.98); a line the model does not produce (one bin at 8 Hz 30 times
-     * higher) stands out in its part by 29 x / m of the m bins there over sqrt(2 / (dof m)) (x, that bin's own ratio
-     * to the fit, 1 on average, is the spread: 0.3-1.5 of that with x = 1) */
-    double zmax = 0.0;
-    for (int j = 0; j < HM_SPECTRUM_FIT_LOCAL_PARTS; ++j) zmax = fmax(zmax, fabs(fit.local_z[j]));
+    /* the residual under a peak (hm_spectrum_fit_peak_z): at one bin k, (x_k - 1) / sqrt(2 / dof) with x_k that bin's
+     * ratio to the fit (about N(0, 1)); a line the model does not produce, bin k 30 times higher, against the same
+     * fit: exactly (30 x_k - 1) / sqrt(2 / dof), and over bins k-1..k+1 the mean's (x_{k-1} + 30 x_k + x_{k+1}) / 3
+     * less 1 over sqrt(2 / (3 dof)); refitted with the line in it, still far beyond the margin's 5. Outside the bins,
+     * or a range upside down: refused. */
     size_t k8 = 0;
     while (k8 + 1 < nb && f[k8] < 8.0) ++k8;
-    const double per_part = (double)nb / HM_SPECTRUM_FIT_LOCAL_PARTS;
+    double z_own = NAN, z_left = NAN, z_right = NAN, z_line = NAN, z_three = NAN, z_refit = NAN, z_out = -1.0;
+    HM_CHECK(m && hm_spectrum_fit_peak_z(m, c.v_start_kmh, &point, &fit, f, p, nb, dof, f[k8], f[k8], &z_own) == HM_OK &&
+                 hm_spectrum_fit_peak_z(m, c.v_start_kmh, &point, &fit, f, p, nb, dof, f[k8 - 1], f[k8 - 1], &z_left) ==
+                     HM_OK &&
+                 hm_spectrum_fit_peak_z(m, c.v_start_kmh, &point, &fit, f, p, nb, dof, f[k8 + 1], f[k8 + 1],
+                                        &z_right) == HM_OK,
+             "the residual at a bin");
+    const double se1 = sqrt(2.0 / dof), x_k = 1.0 + z_own * se1;
+    const double x_l = 1.0 + z_left * se1, x_r = 1.0 + z_right * se1;
     p[k8] *= 30.0;
     hm_spectrum_fit lined;
-    HM_CHECK(m && hm_spectrum_fit_conicity(m, c.v_start_kmh, &point, f, p, nb, dof, &o, &lined) == HM_OK, "refit");
-    const double z8 = hm_spectrum_fit_local_z(lined.local_z, lined.local_low_hz, lined.local_high_hz, lined.bins, f[k8], f[k8]);
-    const double expect = 29.0 / per_part / sqrt(2.0 / (dof * per_part));
-    printf("  its residual: the largest |z| of %d parts %.2f; with a line at %.2f Hz %.1f there (%.0f expected)\n",
-           HM_SPECTRUM_FIT_LOCAL_PARTS, zmax, f[k8], z8, expect);
-    HM_CHECK(zmax < 5.0, "the model's own spectrum explained part by part");
-    HM_CHECK(z8 > 0.3 * expect && z8 < 1.5 * expect, "the line stands out where it is");
-    HM_CHECK(isnan(hm_spectrum_fit_local_z(lined.local_z, lined.local_low_hz, lined.local_high_hz, lined.bins, 30.0, 31.0)) &&
-                 hm_spectrum_fit_local_z(lined.local_z, lined.local_low_hz, lined.local_high_hz, lined.bins, 4.0, 30.0) >= z8,
-             "outside the band: none; over it all: the largest");
+    HM_CHECK(hm_spectrum_fit_peak_z(m, c.v_start_kmh, &point, &fit, f, p, nb, dof, f[k8] - 1e-9, f[k8] + 1e-9,
+                                    &z_line) == HM_OK &&
+                 hm_spectrum_fit_peak_z(m, c.v_start_kmh, &point, &fit, f, p, nb, dof, f[k8 - 1], f[k8 + 1],
+                                        &z_three) == HM_OK,
+             "the residual under the line");
+    HM_CHECK(m && hm_spectrum_fit_conicity(m, c.v_start_kmh, &point, f, p, nb, dof, &o, &lined) == HM_OK &&
+                 hm_spectrum_fit_peak_z(m, c.v_start_kmh, &point, &lined, f, p, nb, dof, f[k8], f[k8], &z_refit) ==
+                     HM_OK,
+             "refit");
+    const double expect = (30.0 * x_k - 1.0) / se1;
+    const double expect3 = ((x_l + 30.0 * x_k + x_r) / 3.0 - 1.0) / sqrt(2.0 / (3.0 * dof));
+    printf("  its residual at %.2f Hz: %.2f (x %.3f); with a line 30 times that bin: %.1f (%.1f expected), over "
+           "three bins %.1f (%.1f), refitted %.1f\n", f[k8], z_own, x_k, z_line, expect, z_three, expect3, z_refit);
+    HM_CHECK(fabs(z_own) < 4.0 && fabs(z_left) < 4.0 && fabs(z_right) < 4.0, "the model's own spectrum explained");
+    HM_CHECK(fabs(z_line - expect) <= 1e-9 * expect && fabs(z_three - expect3) <= 1e-9 * expect3,
+             "the line's residual at its bin and over three");
+    HM_CHECK(z_refit > 20.0, "refitted with the line in it: still far out");
+    HM_CHECK(hm_spectrum_fit_peak_z(m, c.v_start_kmh, &point, &lined, f, p, nb, dof, 30.0, 31.0, &z_out) ==
+                     HM_EDOMAIN &&
+                 hm_spectrum_fit_peak_z(m, c.v_start_kmh, &point, &lined, f, p, nb, dof, 9.0, 8.0, &z_out) ==
+                     HM_EDOMAIN &&
+                 z_out == -1.0,
+             "outside the band, or upside down: refused, the output untouched");
     p[k8] /= 30.0;
     hm_mode_model_destroy(m);
   }

@@ -7,7 +7,6 @@
 #include <string.h>
 
 #include "hunting_monitor/linear.h"
-#include "hunting_monitor/spectrum_fit.h"
 #include "validate.h"
 
 typedef struct {
@@ -311,22 +310,17 @@ static int spectrum_explains(const hm_margin m, const hm_mode_estimate *mode) {
          mode->spectrum_shape_chi2 <= m->cfg.spectrum_max_shape_chi2;
 }
 
-/* ... and the peak of a pair (frequency, decay rate) of the window's reading: the residual's parts under f -+
- * |sigma| / 2 pi within HM_MARGIN_READING_LOCAL_Z (margin.h). */
-static int spectrum_explains_peak(const hm_mode_estimate *mode, double f_hz, double sigma) {
-  const double hw = fabs(sigma) / (2.0 * HM_PI);
-  const double z = hm_spectrum_fit_local_z(mode->spectrum_local_z, mode->spectrum_local_low_hz,
-                                           mode->spectrum_local_high_hz, mode->spectrum_local_bins, f_hz - hw,
-                                           f_hz + hw);
-  return z <= HM_MARGIN_READING_LOCAL_Z; /* (NAN: a peak outside the fitted band, not explained) */
+/* ... and a pair's peak: the fit's residual under it (modal.h's spectrum_peak_z) within HM_MARGIN_READING_LOCAL_Z. */
+static int spectrum_explains_peak(double z) {
+  return fabs(z) <= HM_MARGIN_READING_LOCAL_Z; /* (NAN: not measured, not explained) */
 }
 
 /* The window's pole pairs misfit (v HM_WINDOW_MISFIT) where the spectrum, which gives the conicity, explains the
  * window and each pair's peak: the reading's failing (HM_WINDOW_READING_MISFIT, margin.h). */
 static int reading_failed(const hm_margin m, const hm_mode_estimate *mode) {
-  return m->cfg.spectrum_conicity && spectrum_explains(m, mode) &&
-         spectrum_explains_peak(mode, mode->frequency_hz, mode->decay_rate_1_s) &&
-         (mode->poles < 2 || spectrum_explains_peak(mode, mode->second_frequency_hz, mode->second_decay_rate_1_s));
+  return m->cfg.spectrum_conicity && spectrum_explains(m, mode) && (mode->poles == 1 || mode->poles == 2) &&
+         spectrum_explains_peak(mode->spectrum_peak_z) &&
+         (mode->poles < 2 || spectrum_explains_peak(mode->spectrum_second_peak_z));
 }
 
 /* A window whose mode the model explains (its reading inverted within max_misfit_chi2) takes its conicity from the

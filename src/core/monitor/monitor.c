@@ -336,22 +336,24 @@ static double wheelset_displacement(void *ctx, double f_hz, double speed_kmh) {
  * implies), for the margin (margin.h): where it has a model and the band set, the window's mode was read and no narrow
  * peak (a line or the mode, the margin's question) is in it. A full window is fitted; a stretch's provisional one
  * takes the stretch's last fit while that is less than HM_MONITOR_SPECTRUM_EVERY_S old (a fit takes 0.1-0.4 s of a
- * bogie's spectrum: every second it would hold the monitor behind real time). */
+ * bogie's spectrum: every second it would hold the monitor behind real time). The fit's residual under the reading's
+ * peaks (f -+ max(|sigma| / 2 pi, 2 / T)) is measured on the window's own spectrum, with the fit it takes. */
 static void spectrum_of(hm_monitor m, double t, double stretch_start, int full, hm_mode_estimate *e) {
   e->spectrum_valid = 0;
+  e->spectrum_peak_z = e->spectrum_second_peak_z = NAN;
   if (!m->spec_f || !e->valid || e->narrow_peak) return;
   e->spectrum_valid = -1; /* (until a fit succeeds: a window asked for and not fitted is a misfit, margin.h) */
   const int reuse = !full && fabs(m->spec_stretch - stretch_start) < 0.5 && t - m->spec_at >= 0.0 &&
                     t - m->spec_at < HM_MONITOR_SPECTRUM_EVERY_S; /* (false while spec_at is NAN) */
+  size_t n;
+  double dof, window_s;
+  if (hm_modal_window_spectrum(m->modal, m->cfg.margin.spectrum_low_hz, m->cfg.margin.spectrum_high_hz, m->spec_f,
+                               m->spec_p, HM_SPECTRUM_FIT_MAX_BINS, &n, &dof, &window_s) != HM_OK)
+    return;
   if (!reuse) {
-    size_t n;
-    double dof, window_s;
     hm_spectrum_fit_options o;
     hm_spectrum_fit_options_default(&o);
     m->spec_at = NAN;
-    if (hm_modal_window_spectrum(m->modal, m->cfg.margin.spectrum_low_hz, m->cfg.margin.spectrum_high_hz, m->spec_f,
-                                 m->spec_p, HM_SPECTRUM_FIT_MAX_BINS, &n, &dof, &window_s) != HM_OK)
-      return;
     o.window_s = window_s;
     if (hm_spectrum_fit_conicity(m->model, m->mode_speed, &m->sensor, m->spec_f, m->spec_p, n, dof, &o,
                                  &m->spec_last) != HM_OK)
@@ -367,11 +369,15 @@ static void spectrum_of(hm_monitor m, double t, double stretch_start, int full, 
   e->spectrum_motion_rms_m = fit->motion_rms_m;
   e->spectrum_shape_chi2 = fit->shape_chi2;
   e->spectrum_model_share = fit->model_share;
-  _Static_assert(HM_MODAL_SPECTRUM_LOCAL_PARTS == HM_SPECTRUM_FIT_LOCAL_PARTS, "the local residual's parts");
-  e->spectrum_local_low_hz = fit->local_low_hz;
-  e->spectrum_local_high_hz = fit->local_high_hz;
-  e->spectrum_local_bins = fit->bins;
-  memcpy(e->spectrum_local_z, fit->local_z, sizeof e->spectrum_local_z);
+  const double min_hw = 2.0 / fmax(window_s, 1.0);
+  for (unsigned k = 0; k < e->poles && k < 2; ++k) {
+    const double f = k ? e->second_frequency_hz : e->frequency_hz;
+    const double hw = fmax(fabs(k ? e->second_decay_rate_1_s : e->decay_rate_1_s) / (2.0 * HM_PI), min_hw);
+    double z = NAN;
+    if (hm_spectrum_fit_peak_z(m->model, m->mode_speed, &m->sensor, fit, m->spec_f, m->spec_p, n, dof, f - hw, f + hw,
+                               &z) == HM_OK)
+      *(k ? &e->spectrum_second_peak_z : &e->spectrum_peak_z) = z;
+  }
 }
 
 /* A fit of the identification. At a steady speed (the newest stretch whose speed varied by at most the margin's

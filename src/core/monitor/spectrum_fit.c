@@ -149,14 +149,6 @@ hm_status hm_spectrum_fit_conicity(hm_mode_model m, double speed_kmh, const hm_s
     const double mj = (double)(k1 - k0), z = (sx / mj - 1.0) / sqrt(2.0 / (dof * mj));
     shape += z * z;
   }
-  double local[HM_SPECTRUM_FIT_LOCAL_PARTS];
-  for (int j = 0; j < HM_SPECTRUM_FIT_LOCAL_PARTS; ++j) { /* the same, told part by part */
-    const size_t k0 = n * (size_t)j / HM_SPECTRUM_FIT_LOCAL_PARTS, k1 = n * (size_t)(j + 1) / HM_SPECTRUM_FIT_LOCAL_PARTS;
-    double sx = 0.0;
-    for (size_t k = k0; k < k1; ++k) sx += psd[k] / (amp * g[k] + fl);
-    const double mj = (double)(k1 - k0);
-    local[j] = (sx / mj - 1.0) / sqrt(2.0 / (dof * mj));
-  }
   const double dl = 0.01 * lam, lp = objective(&c, lam + dl), lm = objective(&c, lam - dl);
   const double curv = dof * (lp - 2.0 * l0 + lm) / (dl * dl);
   if (!isfinite(l0) || !isfinite(curv)) return HM_ENOCONV;
@@ -171,29 +163,39 @@ hm_status hm_spectrum_fit_conicity(hm_mode_model m, double speed_kmh, const hm_s
   out->deviance_per_bin = dev / (double)n;
   out->shape_chi2 = shape;
   out->model_share = carried / total;
-  out->local_low_hz = f_hz[0];
-  out->local_high_hz = f_hz[n - 1];
-  memcpy(out->local_z, local, sizeof local);
+  out->running = run;
   return HM_OK;
 }
 
-/* The part holding bin k of n (the partition above). */
-static int part_of(size_t k, size_t n) {
-  int j = 0;
-  while (j + 1 < HM_SPECTRUM_FIT_LOCAL_PARTS && n * (size_t)(j + 1) / HM_SPECTRUM_FIT_LOCAL_PARTS <= k) ++j;
-  return j;
-}
-
-double hm_spectrum_fit_local_z(const double *local_z, double local_low_hz, double local_high_hz, size_t bins,
-                               double f_lo_hz, double f_hi_hz) {
-  const double span = local_high_hz - local_low_hz, mid = 0.5 * (f_lo_hz + f_hi_hz);
-  if (!local_z || bins < 2 || !(span > 0.0) || !isfinite(span) || !(f_hi_hz >= f_lo_hz) || !(mid >= local_low_hz) ||
-      !(mid <= local_high_hz))
-    return NAN;
-  const double per_bin = (double)(bins - 1) / span, last = (double)(bins - 1);
-  const size_t k0 = (size_t)fmin(last, fmax(0.0, round((f_lo_hz - local_low_hz) * per_bin)));
-  const size_t k1 = (size_t)fmin(last, fmax(0.0, round((f_hi_hz - local_low_hz) * per_bin)));
-  double worst = 0.0;
-  for (int j = part_of(k0, bins); j <= part_of(k1, bins); ++j) worst = fmax(worst, fabs(local_z[j]));
-  return worst;
+hm_status hm_spectrum_fit_peak_z(hm_mode_model m, double speed_kmh, const hm_sensor_point *point,
+                                 const hm_spectrum_fit *fit, const double *f_hz, const double *psd, size_t n,
+                                 double dof, double f_lo_hz, double f_hi_hz, double *z) {
+  const double mid = 0.5 * (f_lo_hz + f_hi_hz);
+  if (!m || !point || !fit || !f_hz || !psd || !z || n == 0 || n > HM_SPECTRUM_FIT_MAX_BINS || !(dof > 0.0) ||
+      !isfinite(dof) || !(f_hi_hz >= f_lo_hz) || !isfinite(f_lo_hz) || !isfinite(f_hi_hz) || !(mid >= f_hz[0]) ||
+      !(mid <= f_hz[n - 1]) || !(fit->conicity > 0.0) || !(fit->amplitude > 0.0) || !(fit->noise >= 0.0))
+    return HM_EDOMAIN;
+  size_t k0 = 0;
+  while (k0 < n && f_hz[k0] < f_lo_hz) ++k0;
+  size_t k1 = k0;
+  while (k1 < n && f_hz[k1] <= f_hi_hz) ++k1; /* [k0, k1): the bins in the range */
+  if (k1 == k0) { /* none: the nearest to the middle */
+    size_t kn = 0;
+    for (size_t k = 1; k < n; ++k)
+      if (fabs(f_hz[k] - mid) < fabs(f_hz[kn] - mid)) kn = k;
+    k0 = kn, k1 = kn + 1;
+  }
+  double g[HM_SPECTRUM_FIT_MAX_BINS];
+  if (hm_mode_model_running_spectrum(m, fit->conicity, speed_kmh, point, &fit->running, f_hz + k0, k1 - k0, g) !=
+      HM_OK)
+    return HM_ENOCONV;
+  double sx = 0.0;
+  for (size_t k = k0; k < k1; ++k) {
+    const double x = psd[k] / (fit->amplitude * g[k - k0] + fit->noise);
+    if (!isfinite(x)) return HM_EDOMAIN;
+    sx += x;
+  }
+  const double mk = (double)(k1 - k0);
+  *z = (sx / mk - 1.0) / sqrt(2.0 / (dof * mk));
+  return HM_OK;
 }
