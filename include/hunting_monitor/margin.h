@@ -133,8 +133,10 @@ typedef struct {
  * 13.4 Hz mode beside a 16.9 Hz one as two pairs at 14.5 and 16.8 Hz, or its 8 Hz mode as one pair, which the model's
  * readings (several modes, the reading switching between them with the conicity) cannot be inverted to, while the
  * spectrum explains the window and its 0.161 +- 0.004 is the truth's 0.16; three such windows had held model_mismatch
- * for the run. A narrow peak the model does not produce (a review's nearly undamped pair; one bin 20 times the fit in
- * the monitor's periodogram, dof about 2, stands about 19 out) stays a misfit. */
+ * for the run. A pair narrower than that range (|sigma| / 2 pi below 2 / T) is never excused: averaged over the
+ * range's 4-9 bins of the monitor's zero-padded periodogram (dof about 2 at 40 s, 1 at 20 s) a narrow peak the model
+ * does not produce could read under the bar (a review's 8.1 Hz pair at -0.05 1/s, 20 times the fit in one bin: z
+ * 8-10 at 40 s, 4-6 at 20 s). */
 #define HM_MARGIN_READING_LOCAL_Z 5.0
 
 /* Defaults: 1%, 5%, 12 km/h, 200 km/h, 900 s, 20 km/h, 150 km/h, z = 2 (about 95%), misfit chi2 9 (3 standard

@@ -347,13 +347,13 @@ static void spectrum_of(hm_monitor m, double t, double stretch_start, int full, 
                     t - m->spec_at < HM_MONITOR_SPECTRUM_EVERY_S; /* (false while spec_at is NAN) */
   size_t n;
   double dof, window_s;
+  if (!reuse) m->spec_at = NAN; /* (a fit not made now is no longer the stretch's) */
   if (hm_modal_window_spectrum(m->modal, m->cfg.margin.spectrum_low_hz, m->cfg.margin.spectrum_high_hz, m->spec_f,
                                m->spec_p, HM_SPECTRUM_FIT_MAX_BINS, &n, &dof, &window_s) != HM_OK)
     return;
   if (!reuse) {
     hm_spectrum_fit_options o;
     hm_spectrum_fit_options_default(&o);
-    m->spec_at = NAN;
     o.window_s = window_s;
     if (hm_spectrum_fit_conicity(m->model, m->mode_speed, &m->sensor, m->spec_f, m->spec_p, n, dof, &o,
                                  &m->spec_last) != HM_OK)
