@@ -216,9 +216,13 @@ typedef struct {
   double spectrum_conicity, spectrum_conicity_se, spectrum_conicity_at_rest, spectrum_motion_rms_m;
   double spectrum_shape_chi2, spectrum_model_share;
   /* and its residual under the reading's peaks (spectrum_fit.h's hm_spectrum_fit_peak_z over f -+ max(|sigma| / 2 pi,
-   * 2 / T) of the window's spectrum): the first pair's and the second's (NAN: not measured) */
+   * HM_MODAL_PEAK_MIN_HALFWIDTH / T) of the window's spectrum): the first pair's and the second's (NAN: not measured) */
   double spectrum_peak_z, spectrum_second_peak_z;
 } hm_mode_estimate;
+
+/* The least half-width of the range spectrum_peak_z is measured over, times the window's length T [Hz s]: 2 / T, a
+ * few bins of the window's periodogram (a narrower pair's peak is averaged with the bins beside it: margin.h) */
+#define HM_MODAL_PEAK_MIN_HALFWIDTH 2.0
 
 /* The window's halves' speeds must differ by at least this in ln(V2 / V1) for speed_tracking: a line then moves 1% of
  * its frequency, 0.14 Hz at 14 Hz, 3 bins of a 20 s half. */

@@ -318,9 +318,10 @@ static int spectrum_explains_peak(double z) {
 /* The window's pole pairs misfit (v HM_WINDOW_MISFIT) where the spectrum, which gives the conicity, explains the
  * window and each pair's peak: the reading's failing (HM_WINDOW_READING_MISFIT, margin.h). */
 static int reading_failed(const hm_margin m, const hm_mode_estimate *mode) {
-  /* a pair narrower than the residual's range (|sigma| / 2 pi below 2 / T, monitor.h) has its peak averaged with the
-   * bins beside it: never excused (a review's 8.1 Hz pair at -0.05 1/s, 20 times the fit, read at z 4-6 over 20 s) */
-  const double narrow = 2.0 * HM_PI * 2.0 / fmax(mode->window_s, 1.0);
+  /* a pair narrower than the residual's range (|sigma| / 2 pi below HM_MODAL_PEAK_MIN_HALFWIDTH / T, modal.h) has its
+   * peak averaged with the bins beside it: never excused (a review's 8.1 Hz pair at -0.05 1/s, 20 times the fit, read
+   * at z 4-6 over 20 s) */
+  const double narrow = 2.0 * HM_PI * HM_MODAL_PEAK_MIN_HALFWIDTH / fmax(mode->window_s, 1.0);
   return m->cfg.spectrum_conicity && spectrum_explains(m, mode) && (mode->poles == 1 || mode->poles == 2) &&
          fabs(mode->decay_rate_1_s) >= narrow && spectrum_explains_peak(mode->spectrum_peak_z) &&
          (mode->poles < 2 ||

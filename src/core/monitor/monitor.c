@@ -337,7 +337,8 @@ static double wheelset_displacement(void *ctx, double f_hz, double speed_kmh) {
  * peak (a line or the mode, the margin's question) is in it. A full window is fitted; a stretch's provisional one
  * takes the stretch's last fit while that is less than HM_MONITOR_SPECTRUM_EVERY_S old (a fit takes 0.1-0.4 s of a
  * bogie's spectrum: every second it would hold the monitor behind real time). The fit's residual under the reading's
- * peaks (f -+ max(|sigma| / 2 pi, 2 / T)) is measured on the window's own spectrum, with the fit it takes. */
+ * peaks (f -+ max(|sigma| / 2 pi, HM_MODAL_PEAK_MIN_HALFWIDTH / T)) is measured on the window's own spectrum, with
+ * the fit it takes. */
 static void spectrum_of(hm_monitor m, double t, double stretch_start, int full, hm_mode_estimate *e) {
   e->spectrum_valid = 0;
   e->spectrum_peak_z = e->spectrum_second_peak_z = NAN;
@@ -369,7 +370,7 @@ static void spectrum_of(hm_monitor m, double t, double stretch_start, int full, 
   e->spectrum_motion_rms_m = fit->motion_rms_m;
   e->spectrum_shape_chi2 = fit->shape_chi2;
   e->spectrum_model_share = fit->model_share;
-  const double min_hw = 2.0 / fmax(window_s, 1.0);
+  const double min_hw = HM_MODAL_PEAK_MIN_HALFWIDTH / fmax(window_s, 1.0);
   for (unsigned k = 0; k < e->poles && k < 2; ++k) {
     const double f = k ? e->second_frequency_hz : e->frequency_hz;
     const double hw = fmax(fabs(k ? e->second_decay_rate_1_s : e->decay_rate_1_s) / (2.0 * HM_PI), min_hw);

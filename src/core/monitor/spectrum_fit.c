@@ -64,6 +64,14 @@ static double objective(fit_ctx *c, double lambda) {
   return profile(c->g, c->p, c->n, &c->amp, &c->floor_);
 }
 
+/* The mean of x = psd / (amp g + fl) over m bins, less 1, in its standard error sqrt(2 / (dof m)) (x of m bins of
+ * dof / 2 periodograms each: about N(0, 1) where the model explains them); non-finite where an x is. */
+static double mean_ratio_z(const double *psd, const double *g, size_t m, double amp, double fl, double dof) {
+  double sx = 0.0;
+  for (size_t k = 0; k < m; ++k) sx += psd[k] / (amp * g[k] + fl);
+  return (sx / (double)m - 1.0) / sqrt(2.0 / (dof * (double)m));
+}
+
 /* The minimum over [lo, hi]: a geometric scan of `scan` points, then golden section in ln(conicity) over the best
  * point's neighbours to tol. 0 where it lies at an end of the range (not bracketed) or nothing was finite. */
 static int minimise(fit_ctx *c, double lo, double hi, int scan, double tol, double *lambda) {
@@ -140,13 +148,11 @@ hm_status hm_spectrum_fit_conicity(hm_mode_model m, double speed_kmh, const hm_s
     carried += amp * g[k], total += amp * g[k] + fl;
   }
   /* the fit's shape against the spectrum's: the mean of x over each of SHAPE_PARTS equal parts of the bins is 1 within
-   * sqrt(2 / (dof m)) where the model explains them (x of m bins of dof / 2 periodograms each); their chi2 */
+   * its standard error where the model explains them; their chi2 */
   double shape = 0.0;
   for (int j = 0; j < SHAPE_PARTS; ++j) {
     const size_t k0 = n * (size_t)j / SHAPE_PARTS, k1 = n * (size_t)(j + 1) / SHAPE_PARTS;
-    double sx = 0.0;
-    for (size_t k = k0; k < k1; ++k) sx += psd[k] / (amp * g[k] + fl);
-    const double mj = (double)(k1 - k0), z = (sx / mj - 1.0) / sqrt(2.0 / (dof * mj));
+    const double z = mean_ratio_z(psd + k0, g + k0, k1 - k0, amp, fl, dof);
     shape += z * z;
   }
   const double dl = 0.01 * lam, lp = objective(&c, lam + dl), lm = objective(&c, lam - dl);
@@ -189,13 +195,8 @@ hm_status hm_spectrum_fit_peak_z(hm_mode_model m, double speed_kmh, const hm_sen
   if (hm_mode_model_running_spectrum(m, fit->conicity, speed_kmh, point, &fit->running, f_hz + k0, k1 - k0, g) !=
       HM_OK)
     return HM_ENOCONV;
-  double sx = 0.0;
-  for (size_t k = k0; k < k1; ++k) {
-    const double x = psd[k] / (fit->amplitude * g[k - k0] + fit->noise);
-    if (!isfinite(x)) return HM_EDOMAIN;
-    sx += x;
-  }
-  const double mk = (double)(k1 - k0);
-  *z = (sx / mk - 1.0) / sqrt(2.0 / (dof * mk));
+  const double zk = mean_ratio_z(psd + k0, g, k1 - k0, fit->amplitude, fit->noise, dof);
+  if (!isfinite(zk)) return HM_EDOMAIN;
+  *z = zk;
   return HM_OK;
 }
