@@ -1,6 +1,8 @@
 // soak_probe: listens to hunting_monitor_node for a given time (scripts/soak) and prints JSON: statuses received
 // against the 20 Hz expected (over the whole run, which includes the node's start, and after the warm-up), the age of the newest acceleration sample behind each status on arrival (median,
-// p99, max), the levels seen after a warm-up, and the node's own count of accepted samples (from /diagnostics).
+// p99, max), the levels seen after a warm-up with the reason codes of those not OK (alarm.h's hm_reason: what a
+// failing soak was told, e.g. a starved simulator's lost samples as WATCH partly blind, 16), and the node's own count
+// of accepted samples (from /diagnostics).
 //   soak_probe SECONDS [WARMUP_SECONDS]
 #include <diagnostic_msgs/DiagnosticArray.h>
 #include <hunting_monitor/HuntingStatus.h>
@@ -9,6 +11,7 @@
 #include <algorithm>
 #include <cstdio>
 #include <cstdlib>
+#include <map>
 #include <mutex>
 #include <string>
 #include <vector>
@@ -24,6 +27,7 @@ int main(int argc, char** argv) {
   std::mutex lock;
   std::vector<double> ages;
   long statuses = 0, after_warmup = 0, levels[5] = {0, 0, 0, 0, 0};
+  std::map<int, long> reasons; /* reason_code -> statuses not OK after the warm-up */
   std::string samples = "0", rejected = "0", gaps = "0";
   const ros::WallTime start = ros::WallTime::now();
   ros::Subscriber sub = nh.subscribe<hunting_monitor::HuntingStatus>(
@@ -34,6 +38,7 @@ int main(int argc, char** argv) {
         if ((ros::WallTime::now() - start).toSec() < warmup) return;
         ++after_warmup;
         if (m->level < 5) ++levels[m->level];
+        if (m->level != hunting_monitor::HuntingStatus::LEVEL_OK) ++reasons[m->reason_code];
         if (!m->accel_stamp.isZero()) ages.push_back((ros::Time::now() - m->accel_stamp).toSec());
       },
       ros::VoidConstPtr(), ros::TransportHints().tcpNoDelay());
@@ -55,12 +60,16 @@ int main(int argc, char** argv) {
   std::lock_guard<std::mutex> g(lock);
   std::sort(ages.begin(), ages.end());
   const auto pct = [&](double p) { return ages.empty() ? -1.0 : 1e3 * ages[static_cast<size_t>(p * (ages.size() - 1))]; };
+  std::string not_ok = "{";
+  for (const auto& r : reasons)
+    not_ok += (not_ok.size() > 1 ? ", \"" : "\"") + std::to_string(r.first) + "\": " + std::to_string(r.second);
+  not_ok += "}";
   std::printf("{\"seconds\": %.0f, \"statuses\": %ld, \"statuses_expected\": %.0f, \"statuses_after_warmup\": %ld, "
               "\"statuses_expected_after_warmup\": %.0f, \"latency_ms_median\": %.3f, "
               "\"latency_ms_p99\": %.3f, \"latency_ms_max\": %.3f, \"levels_after_warmup\": {\"NO_DATA\": %ld, \"OK\": "
               "%ld, \"WATCH\": %ld, \"WARN\": %ld, \"ALARM\": %ld}, \"node_samples_accepted\": %s, "
-              "\"node_rejected_out_of_order\": %s, \"node_gaps\": %s}\n",
+              "\"node_rejected_out_of_order\": %s, \"node_gaps\": %s, \"reason_codes_not_ok\": %s}\n",
               seconds, statuses, 20.0 * seconds, after_warmup, 20.0 * (seconds - warmup), pct(0.5), pct(0.99), pct(1.0), levels[0], levels[1], levels[2],
-              levels[3], levels[4], samples.c_str(), rejected.c_str(), gaps.c_str());
+              levels[3], levels[4], samples.c_str(), rejected.c_str(), gaps.c_str(), not_ok.c_str());
   return 0;
 }
