@@ -73,8 +73,9 @@ typedef struct {
  * (amplitude g + noise), g the model's spectrum at the fit's conicity and linearisation, less 1, over its standard
  * error sqrt(2 / (dof m)) for m bins: about N(0, 1) where the model's spectrum is the measured one there; a peak the
  * model does not produce, one bin of m 20 times the fit, 19 / sqrt(2 m / dof) (the margin excuses no pair whose peak
- * is that narrow, margin.h). HM_EDOMAIN for bad input (f_lo_hz above f_hi_hz, the range's middle outside the bins,
- * non-finite values), HM_ENOCONV where the model gives no spectrum; *z untouched then. */
+ * is that narrow, margin.h). HM_EDOMAIN for bad input (a NULL pointer, f_lo_hz above f_hi_hz, the range's middle
+ * outside the bins, a bin of the range negative or not finite, a fit without a positive finite amplitude, non-finite
+ * values), HM_ENOCONV where the model gives no spectrum; *z untouched then. */
 hm_status hm_spectrum_fit_peak_z(hm_mode_model m, double speed_kmh, const hm_sensor_point *point,
                                  const hm_spectrum_fit *fit, const double *f_hz, const double *psd, size_t n,
                                  double dof, double f_lo_hz, double f_hi_hz, double *z);

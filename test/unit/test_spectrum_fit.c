@@ -149,6 +149,26 @@ static void finds_the_conicity(void) {
                      HM_EDOMAIN &&
                  z_out == -1.0,
              "outside the band, or upside down: refused, the output untouched");
+    /* a density negative or not finite in the range, a fit with an infinite amplitude, a NULL pointer: refused */
+    hm_spectrum_fit inf_amp = lined;
+    inf_amp.amplitude = INFINITY;
+    const double keep = p[k8];
+    p[k8] = -1e-6;
+    const hm_status negative = hm_spectrum_fit_peak_z(m, c.v_start_kmh, &point, &lined, f, p, nb, dof, f[k8], f[k8],
+                                                      &z_out);
+    p[k8] = INFINITY;
+    const hm_status infinite = hm_spectrum_fit_peak_z(m, c.v_start_kmh, &point, &lined, f, p, nb, dof, f[k8 - 1],
+                                                      f[k8 + 1], &z_out);
+    p[k8] = keep;
+    HM_CHECK(negative == HM_EDOMAIN && infinite == HM_EDOMAIN &&
+                 hm_spectrum_fit_peak_z(m, c.v_start_kmh, &point, &inf_amp, f, p, nb, dof, f[k8], f[k8], &z_out) ==
+                     HM_EDOMAIN &&
+                 hm_spectrum_fit_peak_z(m, c.v_start_kmh, &point, NULL, f, p, nb, dof, f[k8], f[k8], &z_out) ==
+                     HM_EDOMAIN &&
+                 hm_spectrum_fit_peak_z(m, c.v_start_kmh, &point, &lined, f, p, nb, dof, f[k8], f[k8], NULL) ==
+                     HM_EDOMAIN &&
+                 z_out == -1.0,
+             "a negative or infinite density, an infinite amplitude, NULL: refused, the output untouched");
     p[k8] /= 30.0;
     hm_mode_model_destroy(m);
   }

@@ -179,7 +179,8 @@ hm_status hm_spectrum_fit_peak_z(hm_mode_model m, double speed_kmh, const hm_sen
   const double mid = 0.5 * (f_lo_hz + f_hi_hz);
   if (!m || !point || !fit || !f_hz || !psd || !z || n == 0 || n > HM_SPECTRUM_FIT_MAX_BINS || !(dof > 0.0) ||
       !isfinite(dof) || !(f_hi_hz >= f_lo_hz) || !isfinite(f_lo_hz) || !isfinite(f_hi_hz) || !(mid >= f_hz[0]) ||
-      !(mid <= f_hz[n - 1]) || !(fit->conicity > 0.0) || !(fit->amplitude > 0.0) || !(fit->noise >= 0.0))
+      !(mid <= f_hz[n - 1]) || !(fit->conicity > 0.0) || !(fit->amplitude > 0.0) || !isfinite(fit->amplitude) ||
+      !(fit->noise >= 0.0) || !isfinite(fit->noise))
     return HM_EDOMAIN;
   size_t k0 = 0;
   while (k0 < n && f_hz[k0] < f_lo_hz) ++k0;
@@ -191,6 +192,8 @@ hm_status hm_spectrum_fit_peak_z(hm_mode_model m, double speed_kmh, const hm_sen
       if (fabs(f_hz[k] - mid) < fabs(f_hz[kn] - mid)) kn = k;
     k0 = kn, k1 = kn + 1;
   }
+  for (size_t k = k0; k < k1; ++k)
+    if (!(psd[k] >= 0.0) || !isfinite(psd[k])) return HM_EDOMAIN; /* (a density, finite and not negative) */
   double g[HM_SPECTRUM_FIT_MAX_BINS];
   if (hm_mode_model_running_spectrum(m, fit->conicity, speed_kmh, point, &fit->running, f_hz + k0, k1 - k0, g) !=
       HM_OK)
