@@ -51,7 +51,8 @@ enum { HM_REPORT_TEXT_LEN = 512 };
   X(lone_line_mps2, NUMBER) X(lone_line_wavelength_m, NUMBER) X(order_lines, INT) X(order_line_wavelength_m, NUMBER)   \
   X(order_line_hz, NUMBER) X(order_line_mps2, NUMBER) X(mode_speed_tracking, NUMBER)                                   \
   X(mode_speed_tracking_se, NUMBER) X(spectrum_conicity, NUMBER) X(spectrum_conicity_se, NUMBER)                     \
-  X(spectrum_motion_rms_m, NUMBER) X(narrow_peak, FLAG) X(narrow_peak_hz, NUMBER)                                     \
+  X(spectrum_motion_rms_m, NUMBER) X(spectrum_shape_chi2, NUMBER) X(spectrum_model_share, NUMBER)                    \
+  X(narrow_peak, FLAG) X(narrow_peak_hz, NUMBER)                                                                       \
   X(narrow_peak_wavelength_m, NUMBER) X(narrow_peak_tracked, FLAG) X(narrow_peak_envelope_ratio, NUMBER)              \
   X(narrow_peak_line_ratio, NUMBER) X(narrow_peak_taken_for, STATIC_TEXT)                                              \
   X(narrow_peak_verdict, INT) X(windows_used, INT)                                                                     \

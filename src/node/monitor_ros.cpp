@@ -501,6 +501,8 @@ void MonitorRos::fillMode(const hm_report& r, hunting_monitor::HuntingStatus& m)
   m.spectrum_conicity = finite(r.spectrum_conicity);
   m.spectrum_conicity_se = finite(r.spectrum_conicity_se);
   m.spectrum_motion_rms_m = finite(r.spectrum_motion_rms_m);
+  m.spectrum_shape_chi2 = finite(r.spectrum_shape_chi2);
+  m.spectrum_model_share = finite(r.spectrum_model_share);
 }
 
 void MonitorRos::fillMargin(const hm_report& r, hunting_monitor::HuntingStatus& m) {

@@ -64,6 +64,20 @@ static void gating_rules(void) {
   st.mode.lines_found = 0;
   hm_report_make(&st, 0.0, &r);
   HM_CHECK(isnan(r.line_fundamental_hz) && isnan(r.line_wavelength_m), "no line: NAN");
+  /* the model's whole spectrum (its conicity and the description's check, shape and share) only where fitted for this
+   * window (spectrum_valid > 0; -1: asked and not fitted) */
+  st = full();
+  st.mode.spectrum_valid = 1;
+  st.mode.spectrum_conicity = 0.152;
+  st.mode.spectrum_shape_chi2 = 7.5;
+  st.mode.spectrum_model_share = 0.97;
+  hm_report_make(&st, 0.0, &r);
+  HM_CHECK(r.spectrum_conicity == 0.152 && r.spectrum_shape_chi2 == 7.5 && r.spectrum_model_share == 0.97,
+           "a spectrum fitted: its conicity, shape and share shown");
+  st.mode.spectrum_valid = -1;
+  hm_report_make(&st, 0.0, &r);
+  HM_CHECK(isnan(r.spectrum_conicity) && isnan(r.spectrum_shape_chi2) && isnan(r.spectrum_model_share),
+           "asked and not fitted: NAN");
   /* the margin's estimates each by its own validity */
   st = full();
   st.margin.conicity_valid = 0;

@@ -104,6 +104,8 @@ static void mode_part(const hm_monitor_status *st, hm_report *r) {
   r->spectrum_conicity = when(sf, md->spectrum_conicity);
   r->spectrum_conicity_se = when(sf, md->spectrum_conicity_se);
   r->spectrum_motion_rms_m = when(sf, md->spectrum_motion_rms_m);
+  r->spectrum_shape_chi2 = when(sf, md->spectrum_shape_chi2);
+  r->spectrum_model_share = when(sf, md->spectrum_model_share);
   r->narrow_peak = md->narrow_peak;
   r->narrow_peak_hz = when(md->narrow_peak, md->narrow_peak_hz);
   r->narrow_peak_wavelength_m = when(md->narrow_peak && md->narrow_peak_wavelength_m > 0.0,
