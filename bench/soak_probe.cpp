@@ -1,11 +1,12 @@
 // soak_probe: listens to hunting_monitor_node for a given time (scripts/soak) and prints JSON: statuses received
 // against the 20 Hz expected (over the whole run, which includes the node's start, and after the warm-up), the age of the newest acceleration sample behind each status on arrival (median,
-// p99, max), the levels seen after a warm-up with the reason codes of those not OK (alarm.h's hm_reason: what a
-// failing soak was told, e.g. a starved simulator's lost samples as WATCH partly blind, 16), and the node's own count
-// of accepted samples (from /diagnostics).
+// p99, max), the levels seen after a warm-up with the reasons of those not OK (alarm.h's hm_reason, its code and
+// hm_reason_text: what a failing soak was told, e.g. a starved simulator's lost samples as WATCH partly blind), and the
+// node's own count of accepted samples (from /diagnostics).
 //   soak_probe SECONDS [WARMUP_SECONDS]
 #include <diagnostic_msgs/DiagnosticArray.h>
 #include <hunting_monitor/HuntingStatus.h>
+#include <hunting_monitor/alarm.h>
 #include <ros/ros.h>
 
 #include <algorithm>
@@ -61,8 +62,13 @@ int main(int argc, char** argv) {
   std::sort(ages.begin(), ages.end());
   const auto pct = [&](double p) { return ages.empty() ? -1.0 : 1e3 * ages[static_cast<size_t>(p * (ages.size() - 1))]; };
   std::string not_ok = "{";
-  for (const auto& r : reasons)
-    not_ok += (not_ok.size() > 1 ? ", \"" : "\"") + std::to_string(r.first) + "\": " + std::to_string(r.second);
+  for (const auto& r : reasons) {
+    std::string text;
+    for (const char* c = hm_reason_text(static_cast<hm_reason>(r.first)); c && *c; ++c)
+      if (*c != '"' && *c != '\\') text += *c;
+    not_ok += (not_ok.size() > 1 ? ", \"" : "\"") + std::to_string(r.first) + "\": {\"statuses\": " +
+              std::to_string(r.second) + ", \"reason\": \"" + text + "\"}";
+  }
   not_ok += "}";
   std::printf("{\"seconds\": %.0f, \"statuses\": %ld, \"statuses_expected\": %.0f, \"statuses_after_warmup\": %ld, "
               "\"statuses_expected_after_warmup\": %.0f, \"latency_ms_median\": %.3f, "
