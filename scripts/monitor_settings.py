@@ -10,14 +10,24 @@ ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 REFERENCE = os.path.join(ROOT, "config", "monitor.yaml")
 
 
+def _header(ln):
+    """The section a line opens, or None."""
+    return ln.split(":")[0].strip() if ln and not ln.startswith((" ", "\t", "#")) else None
+
+
+def _key(ln):
+    """The key an indented `key: value` line sets, or None (a comment, a blank or a header)."""
+    return ln.strip().split(":")[0] if ln.startswith((" ", "\t")) and ":" in ln and not ln.strip().startswith("#") \
+        else None
+
+
 def sections(text):
     """{(section, key)} of a settings file's text."""
     found, section = set(), None
     for ln in text.splitlines():
-        if ln and not ln.startswith((" ", "\t", "#")):
-            section = ln.split(":")[0].strip()
-        elif ln.startswith((" ", "\t")) and ":" in ln and not ln.strip().startswith("#"):
-            found.add((section, ln.strip().split(":")[0]))
+        section = _header(ln) or section
+        if _key(ln) is not None:
+            found.add((section, _key(ln)))
     return found
 
 
@@ -50,10 +60,7 @@ def edited(text, settings, drop=()):
     set), and a section left without keys removed (an empty section is no mapping: the monitor refuses it)."""
     lines, section, done = [], None, set()
     for ln in text.splitlines():
-        if ln and not ln.startswith((" ", "\t", "#")):
-            section = ln.split(":")[0].strip()
-        key = ln.strip().split(":")[0] if ln.startswith((" ", "\t")) and ":" in ln and not ln.strip().startswith(
-            "#") else None
+        section, key = _header(ln) or section, _key(ln)
         if key is not None and (section, key) in settings:
             ln = f"{ln[:len(ln) - len(ln.lstrip())]}{key}: {settings[(section, key)]}"
             done.add((section, key))
@@ -72,6 +79,5 @@ def edited(text, settings, drop=()):
             if ln.strip() and not ln.lstrip().startswith("#"):
                 return ln.startswith((" ", "\t"))
         return False
-    kept = [ln for k, ln in enumerate(lines)
-            if not (ln.rstrip().endswith(":") and not ln.startswith((" ", "\t", "#")) and not has_keys(k))]
+    kept = [ln for k, ln in enumerate(lines) if not (_header(ln) and ln.rstrip().endswith(":") and not has_keys(k))]
     return "\n".join(kept) + "\n"
